@@ -1,0 +1,153 @@
+#include "core/broad_phase/object_broad_phase.hpp"
+
+#include "core/parallel.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace vproxq {
+namespace {
+
+// See rounding_slack(): ~4.5e5 ulps of the coordinate magnitude (2^-52 ~ 2.2e-16).
+constexpr double kSlackPerMagnitude = 1e-10;
+// U_i is computed in double from a few subtractions, squares and a sqrt (< 10 roundings);
+// widening it by 1e-12 relative keeps it an upper bound of the exact value.
+constexpr double kUpperBoundWidening = 1e-12;
+
+bool has_triangles(const Object& o) { return o.num_triangles() > 0; }
+
+/// Index of the triangle corner of `o` nearest to p (over corners of faces only: isolated
+/// vertices are not part of the surface).
+Vec3 nearest_corner(const Object& o, const Vec3& p) {
+  double best = kInfinity;
+  Vec3 best_p = Vec3::Zero();
+  for (const Face& f : o.topology->faces) {
+    for (Index v : f) {
+      const Vec3& q = o.positions[static_cast<size_t>(v)];
+      const double d = (q - p).squaredNorm();
+      if (d < best) {
+        best = d;
+        best_p = q;
+      }
+    }
+  }
+  return best_p;
+}
+
+/// Distance of a pair of surface points of a and b found by walking to nearest corners:
+/// an upper bound on the distance between the objects.
+double vertex_walk_bound(const Object& a, const Object& b, const AABB& box_b) {
+  const Vec3 v = nearest_corner(a, box_b.center());
+  const Vec3 w = nearest_corner(b, v);
+  const Vec3 v2 = nearest_corner(a, w);
+  return (v2 - w).norm();
+}
+
+}  // namespace
+
+double rounding_slack(double magnitude) { return kSlackPerMagnitude * (1.0 + magnitude); }
+
+FrameBoxes FrameBoxes::compute(const Frame& frame, int threads) {
+  FrameBoxes fb;
+  const size_t n = frame.objects.size();
+  fb.triangles.resize(n);
+  fb.objects.assign(n, AABB{});
+  std::vector<double> mags(n, 0.0);
+  parallel_for(n, threads, [&](size_t i) {
+    const Object& o = frame.objects[i];
+    auto& tb = fb.triangles[i];
+    tb.resize(static_cast<size_t>(o.num_triangles()));
+    AABB box;
+    for (Index t = 0; t < o.num_triangles(); ++t) {
+      tb[static_cast<size_t>(t)] = AABB::of(o.triangle(t));
+      box.extend(tb[static_cast<size_t>(t)]);
+    }
+    fb.objects[i] = box;
+    if (!box.empty()) mags[i] = std::max(box.lo.cwiseAbs().maxCoeff(), box.hi.cwiseAbs().maxCoeff());
+  });
+  for (double m : mags) fb.magnitude = std::max(fb.magnitude, m);
+  return fb;
+}
+
+ObjectBroadPhase object_broad_phase(const Frame& frame, const FrameBoxes& boxes, int threads) {
+  const size_t n = frame.objects.size();
+  ObjectBroadPhase out;
+  out.upper_bound.assign(n, kInfinity);
+  out.pns.assign(n, {});
+  const double slack = rounding_slack(boxes.magnitude);
+
+  std::vector<Index> live;  // objects with triangles
+  for (size_t i = 0; i < n; ++i)
+    if (has_triangles(frame.objects[i])) live.push_back(static_cast<Index>(i));
+  if (live.size() < 2) return out;
+
+  // Sorted intervals per axis (Cohen et al. 1995), and the widest box per axis for the sweep.
+  std::array<std::vector<Index>, 3> sorted;
+  std::array<double, 3> max_width{0, 0, 0};
+  for (int k = 0; k < 3; ++k) {
+    sorted[k] = live;
+    std::sort(sorted[k].begin(), sorted[k].end(), [&](Index a, Index b) {
+      const double la = boxes.objects[static_cast<size_t>(a)].lo[k];
+      const double lb = boxes.objects[static_cast<size_t>(b)].lo[k];
+      return la < lb || (la == lb && a < b);
+    });
+    for (Index i : live) {
+      const AABB& b = boxes.objects[static_cast<size_t>(i)];
+      max_width[k] = std::max(max_width[k], b.hi[k] - b.lo[k]);
+    }
+  }
+
+  parallel_for(live.size(), threads, [&](size_t li) {
+    const Index i = live[li];
+    const AABB& bi = boxes.objects[static_cast<size_t>(i)];
+    // Potentially closest object along each axis.
+    std::array<Index, 3> cand{kNoIndex, kNoIndex, kNoIndex};
+    for (int k = 0; k < 3; ++k) {
+      double best_overlap = -kInfinity;
+      for (Index j : sorted[k]) {
+        if (j == i) continue;
+        const double ov = interval_overlap(bi, boxes.objects[static_cast<size_t>(j)], k);
+        if (ov > best_overlap) {
+          best_overlap = ov;
+          cand[k] = j;
+        }
+      }
+    }
+    double u = kInfinity;
+    for (int k = 0; k < 3; ++k) {
+      const Index j = cand[k];
+      if (j == kNoIndex || (k > 0 && (j == cand[0] || (k > 1 && j == cand[1])))) continue;
+      const AABB& bj = boxes.objects[static_cast<size_t>(j)];
+      u = std::min(u, box_max_distance(bi, bj));
+      u = std::min(u, vertex_walk_bound(frame.objects[static_cast<size_t>(i)],
+                                        frame.objects[static_cast<size_t>(j)], bj));
+    }
+    u *= 1 + kUpperBoundWidening;
+    out.upper_bound[static_cast<size_t>(i)] = u;
+
+    // Object-level PNS: sweep along x with the box expanded by the bound.
+    const double reach = u + slack;
+    const auto& sx = sorted[0];
+    const double lo_min = bi.lo.x() - reach - max_width[0];
+    auto first = std::lower_bound(sx.begin(), sx.end(), lo_min, [&](Index a, double v) {
+      return boxes.objects[static_cast<size_t>(a)].lo.x() < v;
+    });
+    std::vector<std::pair<double, Index>> found;
+    for (auto it = first; it != sx.end(); ++it) {
+      const Index j = *it;
+      const AABB& bj = boxes.objects[static_cast<size_t>(j)];
+      if (bj.lo.x() > bi.hi.x() + reach) break;
+      if (j == i) continue;
+      const double d2 = box_distance_squared(bi, bj);
+      if (d2 <= reach * reach) found.emplace_back(d2, j);
+    }
+    std::sort(found.begin(), found.end());
+    auto& pns = out.pns[static_cast<size_t>(i)];
+    pns.reserve(found.size());
+    for (const auto& f : found) pns.push_back(f.second);
+  });
+  return out;
+}
+
+}  // namespace vproxq

@@ -1,0 +1,41 @@
+#pragma once
+// Stage I (paper 5.1): object AABBs, sorted intervals per axis, a conservative upper bound on
+// each object's separation distance, and the object-level potentially neighbouring sets (PNS).
+#include "core/broad_phase/aabb.hpp"
+#include "core/scene.hpp"
+
+#include <vector>
+
+namespace vproxq {
+
+/// Triangle and object boxes of one frame, computed once and shared by the stages.
+struct FrameBoxes {
+  std::vector<std::vector<AABB>> triangles;  ///< [object][triangle]
+  std::vector<AABB> objects;                 ///< empty box for an object without triangles
+  double magnitude = 0;                      ///< largest |coordinate| of any triangle corner
+
+  static FrameBoxes compute(const Frame& frame, int threads);
+};
+
+struct ObjectBroadPhase {
+  /// U_i: the distance from object i to some other object is at most this (kInfinity when
+  /// no other object has triangles).
+  std::vector<double> upper_bound;
+  /// PNS(i): objects j != i whose box lies within upper_bound[i] (+ rounding slack) of i's
+  /// box, sorted by box distance, then id. Every object at distance <= U_i is in it.
+  std::vector<std::vector<Index>> pns;
+};
+
+/// Absolute slack added to bounds before culling, so that rounding in box distances and in
+/// triangle_distance() can never cull a pair whose computed distance ties the bound.
+/// triangle_distance() loses at most a few hundred ulps of the coordinate magnitude; this
+/// allows ~4.5e5 ulps, so the only cost of its size is a handful of extra exact tests.
+double rounding_slack(double magnitude);
+
+/// The paper's rule: along each axis, the object whose interval overlaps i's the most (or the
+/// nearest interval when none overlaps) is a potentially closest object; U_i is the smallest
+/// upper bound over those candidates, each bound being the smaller of the farthest-corner box
+/// distance and the distance of a vertex pair found by a short nearest-vertex walk.
+ObjectBroadPhase object_broad_phase(const Frame& frame, const FrameBoxes& boxes, int threads);
+
+}  // namespace vproxq

@@ -1,0 +1,57 @@
+#include "core/broad_phase/triangle_bvh.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+namespace vproxq {
+
+void TriangleBvh::build(const std::vector<AABB>& boxes) {
+  nodes_.clear();
+  order_.resize(boxes.size());
+  std::iota(order_.begin(), order_.end(), 0);
+  leaf_boxes_.clear();
+  if (boxes.empty()) return;
+  std::vector<Vec3> centroids(boxes.size());
+  for (size_t t = 0; t < boxes.size(); ++t) centroids[t] = boxes[t].center();
+  nodes_.reserve(2 * boxes.size() / kLeafSize + 2);
+  nodes_.push_back({});
+  build_node(0, 0, static_cast<std::int32_t>(boxes.size()), boxes, centroids);
+  leaf_boxes_.resize(order_.size());
+  for (size_t k = 0; k < order_.size(); ++k) leaf_boxes_[k] = boxes[static_cast<size_t>(order_[k])];
+}
+
+// Depth stays below 64 (the query stack size): each split halves the range, and ranges of at
+// most kLeafSize are leaves, so depth <= log2(2^31) + 1.
+void TriangleBvh::build_node(std::int32_t slot, std::int32_t begin, std::int32_t end,
+                             const std::vector<AABB>& boxes, const std::vector<Vec3>& centroids) {
+  Node node;
+  for (std::int32_t k = begin; k < end; ++k) node.box.extend(boxes[static_cast<size_t>(order_[static_cast<size_t>(k)])]);
+  if (end - begin <= kLeafSize) {
+    node.first = begin;
+    node.count = end - begin;
+    nodes_[static_cast<size_t>(slot)] = node;
+    return;
+  }
+  AABB cb;
+  for (std::int32_t k = begin; k < end; ++k) cb.extend(centroids[static_cast<size_t>(order_[static_cast<size_t>(k)])]);
+  int axis = 0;
+  const Vec3 ext = cb.hi - cb.lo;
+  if (ext.y() > ext[axis]) axis = 1;
+  if (ext.z() > ext[axis]) axis = 2;
+  const std::int32_t mid = begin + (end - begin) / 2;
+  std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end, [&](Index a, Index b) {
+    const double ca = centroids[static_cast<size_t>(a)][axis], cbv = centroids[static_cast<size_t>(b)][axis];
+    return ca < cbv || (ca == cbv && a < b);
+  });
+  // Children are an adjacent pair, allocated before recursing.
+  const std::int32_t left = static_cast<std::int32_t>(nodes_.size());
+  nodes_.push_back({});
+  nodes_.push_back({});
+  node.first = left;
+  node.count = 0;
+  nodes_[static_cast<size_t>(slot)] = node;
+  build_node(left, begin, mid, boxes, centroids);
+  build_node(left + 1, mid, end, boxes, centroids);
+}
+
+}  // namespace vproxq

@@ -1,0 +1,70 @@
+#pragma once
+// Per-frame results of the queries, as handed to the writers.
+#include "core/geometry/triangle_distance.hpp"
+#include "core/types.hpp"
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace vproxq {
+
+/// For one object: its nearest other object in the frame and how they come closest.
+/// With no other object in the frame, nearest_object is kNoIndex and distance is infinite.
+struct InterObjectDistance {
+  Index object = kNoIndex;
+  Index nearest_object = kNoIndex;
+  double distance = kInfinity;  ///< 0 when touching or intersecting
+  std::array<Index, 2> triangles{kNoIndex, kNoIndex};  ///< {on object, on nearest_object}
+  std::array<Vec3, 2> points{Vec3::Zero(), Vec3::Zero()};
+  TriangleDistanceCase kind = TriangleDistanceCase::Intersecting;
+
+  bool has_nearest() const { return nearest_object != kNoIndex; }
+};
+
+/// Work counters of one query run on one frame.
+struct DistanceCounters {
+  std::uint64_t object_pns_pairs = 0;  ///< ordered object pairs (i, j) kept by the broad phase
+  std::uint64_t candidate_pairs = 0;   ///< feature-level PNS: (triangle, object) pairs kept by culling
+  std::uint64_t exact_tests = 0;       ///< triangle–triangle distance evaluations
+};
+
+/// Wall-clock milliseconds per stage.
+struct StageTimes {
+  double load = 0, aabb = 0, voronoi = 0, exact = 0, write = 0, total = 0;
+};
+
+struct ObjectInfo {
+  Index id = 0;
+  std::string name;
+  Index vertices = 0;
+  Index triangles = 0;
+  bool is_static = false;
+};
+
+struct FrameResult {
+  int frame = 0;  ///< position in the scene's sequence
+  std::vector<std::string> files;
+  std::vector<ObjectInfo> objects;
+  std::optional<std::vector<InterObjectDistance>> inter;  ///< set when "distance" ran
+  DistanceCounters counters;
+  StageTimes time_ms;
+};
+
+/// What a run was asked and how it ran; written once at the top of each output file.
+struct RunInfo {
+  std::string tool_version = VPROXQ_VERSION;
+  std::string scene;                 ///< scene path as given
+  std::string scene_name;            ///< scene.json "name" (or the file stem)
+  std::vector<std::string> queries;  ///< in canonical order
+  std::string voronoi = "off";       ///< the backend that ran
+  int grid = 0;                      ///< 0: no grid (voronoi off)
+  std::string device;                ///< renderer string, or "" without GPU
+  int threads = 1;
+  std::size_t frame_count = 0;  ///< frames that will be written
+};
+
+inline constexpr int kFormatVersion = 1;
+
+}  // namespace vproxq

@@ -1,0 +1,134 @@
+// Inter-object N-body distance: Stage I + Stage III against the all-pairs brute force.
+#include "core/broad_phase/object_broad_phase.hpp"
+#include "core/query/inter_distance.hpp"
+#include "support/random_scene.hpp"
+
+#include <gtest/gtest.h>
+
+namespace vproxq {
+namespace {
+
+using test::make_blob;
+using test::make_random_frame;
+using test::make_soup;
+using test::Rng;
+
+/// Pipeline and brute force must agree exactly: both evaluate the same triangle pairs in the
+/// same canonical order, so the winning pair and every number are bitwise identical.
+void expect_same(const InterDistanceOutput& got, const InterDistanceOutput& ref, const std::string& what) {
+  ASSERT_EQ(got.per_object.size(), ref.per_object.size()) << what;
+  for (size_t i = 0; i < ref.per_object.size(); ++i) {
+    const auto& g = got.per_object[i];
+    const auto& r = ref.per_object[i];
+    SCOPED_TRACE(what + ", object " + std::to_string(i));
+    EXPECT_EQ(g.object, r.object);
+    EXPECT_EQ(g.nearest_object, r.nearest_object);
+    EXPECT_EQ(g.distance, r.distance);
+    EXPECT_EQ(g.triangles, r.triangles);
+    EXPECT_EQ(g.points[0], r.points[0]);
+    EXPECT_EQ(g.points[1], r.points[1]);
+    EXPECT_EQ(g.kind, r.kind);
+  }
+}
+
+TEST(InterDistance, RandomBlobScenesEqualBruteForce) {
+  for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+    const int n = 2 + static_cast<int>(seed % 9);
+    const double spread = 0.5 + 0.6 * static_cast<double>(seed % 5);  // from overlapping to apart
+    const Frame frame = make_random_frame(seed, n, spread, 1);
+    const auto ref = inter_object_distance_brute_force(frame);
+    for (int threads : {1, 3}) {
+      const auto got = inter_object_distance(frame, {threads});
+      expect_same(got, ref, "seed " + std::to_string(seed) + " threads " + std::to_string(threads));
+      EXPECT_LE(got.counters.exact_tests, ref.counters.exact_tests);
+    }
+  }
+}
+
+TEST(InterDistance, TriangleSoupsWithManyIntersectionsEqualBruteForce) {
+  for (std::uint64_t seed = 100; seed < 106; ++seed) {
+    Rng rng(seed);
+    Frame frame;
+    for (int i = 0; i < 6; ++i)
+      frame.objects.push_back(make_soup(rng, Vec3(rng.uniform(0, 2), rng.uniform(0, 2), 0), 0.6, 0.4,
+                                        30, "soup" + std::to_string(i)));
+    const auto ref = inter_object_distance_brute_force(frame);
+    expect_same(inter_object_distance(frame, {2}), ref, "soup seed " + std::to_string(seed));
+  }
+}
+
+TEST(InterDistance, LargeCoordinateOffsetEqualsBruteForce) {
+  Frame frame = make_random_frame(7, 6, 2.0, 1);
+  for (auto& o : frame.objects)
+    for (auto& p : o.positions) p += Vec3(1e6, -1e6, 1e6);
+  expect_same(inter_object_distance(frame, {2}), inter_object_distance_brute_force(frame), "offset 1e6");
+}
+
+TEST(InterDistance, TiesGoToTheSmallestIds) {
+  // Object 0 in the middle, objects 1 and 2 are mirror images at exactly the same distance;
+  // object 3 is a copy of 2 (same distance to 0, larger id). Nearest of 0 must be 1.
+  Rng rng(3);
+  Object mid = make_blob(rng, Vec3(0, 0, 0), 1.0, 0, 0.0, "mid");
+  Object right = make_blob(rng, Vec3(3, 0, 0), 1.0, 0, 0.0, "right");
+  Object left = make_blob(rng, Vec3(-3, 0, 0), 1.0, 0, 0.0, "left");
+  Object copy = right;
+  copy.name = "copy";
+  Frame frame;
+  frame.objects = {mid, left, right, copy};
+  const auto got = inter_object_distance(frame, {2});
+  expect_same(got, inter_object_distance_brute_force(frame), "ties");
+  EXPECT_EQ(got.per_object[0].nearest_object, 1);
+  EXPECT_DOUBLE_EQ(got.per_object[0].distance, 1.0);
+  EXPECT_EQ(got.per_object[2].nearest_object, 3);  // identical copies: distance 0
+  EXPECT_EQ(got.per_object[2].distance, 0.0);
+}
+
+TEST(InterDistance, SingleObjectAndEmptyObjectsHaveNoNearest) {
+  Rng rng(5);
+  Frame one;
+  one.objects.push_back(make_blob(rng, Vec3::Zero(), 1.0, 1, 0.1, "alone"));
+  auto got = inter_object_distance(one, {1});
+  ASSERT_EQ(got.per_object.size(), 1u);
+  EXPECT_FALSE(got.per_object[0].has_nearest());
+  EXPECT_EQ(got.per_object[0].distance, kInfinity);
+
+  Object empty;
+  empty.name = "empty";
+  empty.topology = std::make_shared<Topology>();
+  one.objects.push_back(empty);
+  one.objects.push_back(make_blob(rng, Vec3(5, 0, 0), 1.0, 1, 0.1, "other"));
+  got = inter_object_distance(one, {2});
+  expect_same(got, inter_object_distance_brute_force(one), "with empty object");
+  EXPECT_FALSE(got.per_object[1].has_nearest());
+  EXPECT_EQ(got.per_object[0].nearest_object, 2);
+}
+
+TEST(ObjectBroadPhase, BoundsAndPnsAreConservative) {
+  for (std::uint64_t seed = 20; seed < 30; ++seed) {
+    const Frame frame = make_random_frame(seed, 12, 4.0, 1);
+    const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
+    const ObjectBroadPhase bp = object_broad_phase(frame, boxes, 2);
+    const auto ref = inter_object_distance_brute_force(frame);
+    for (size_t i = 0; i < frame.objects.size(); ++i) {
+      // U_i bounds the true separation distance from above...
+      EXPECT_GE(bp.upper_bound[i], ref.per_object[i].distance) << "seed " << seed << " object " << i;
+      // ...and every object within U_i (in particular the nearest) is in PNS(i).
+      for (size_t j = 0; j < frame.objects.size(); ++j) {
+        if (j == i) continue;
+        double dij = kInfinity;
+        for (Index a = 0; a < frame.objects[i].num_triangles(); ++a)
+          for (Index b = 0; b < frame.objects[j].num_triangles(); ++b)
+            dij = std::min(dij, triangle_distance(frame.objects[i].triangle(a), frame.objects[j].triangle(b)).distance);
+        if (dij <= bp.upper_bound[i]) {
+          const auto& p = bp.pns[i];
+          EXPECT_NE(std::find(p.begin(), p.end(), static_cast<Index>(j)), p.end())
+              << "seed " << seed << ": object " << j << " at " << dij << " <= U=" << bp.upper_bound[i]
+              << " missing from PNS(" << i << ")";
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace vproxq

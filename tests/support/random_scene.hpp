@@ -1,0 +1,101 @@
+#pragma once
+// Seeded random frames for tests: small deformed closed meshes placed close together, some
+// touching, some overlapping, some exact copies (ties).
+#include "core/scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <cstdint>
+#include <memory>
+#include <random>
+#include <string>
+
+namespace vproxq::test {
+
+/// splitmix64: the same numbers on every platform (std distributions are not portable).
+class Rng {
+ public:
+  explicit Rng(std::uint64_t seed) : s_(seed) {}
+  std::uint64_t next() {
+    std::uint64_t z = (s_ += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+  }
+  double uniform(double lo, double hi) { return lo + (hi - lo) * (next() >> 11) * 0x1.0p-53; }
+  int integer(int lo, int hi) { return lo + static_cast<int>(next() % static_cast<std::uint64_t>(hi - lo + 1)); }
+
+ private:
+  std::uint64_t s_;
+};
+
+/// An octahedron subdivided `levels` times and pushed onto a sphere of radius r, then each
+/// vertex jittered radially by up to `jitter` * r.
+inline Object make_blob(Rng& rng, const Vec3& center, double r, int levels, double jitter,
+                        const std::string& name) {
+  std::vector<Vec3> v = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  std::vector<Face> f = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                         {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  for (int l = 0; l < levels; ++l) {
+    std::vector<Face> nf;
+    std::map<std::pair<Index, Index>, Index> mid;
+    auto midpoint = [&](Index a, Index b) {
+      auto key = std::minmax(a, b);
+      auto it = mid.find({key.first, key.second});
+      if (it != mid.end()) return it->second;
+      v.push_back(((v[static_cast<size_t>(a)] + v[static_cast<size_t>(b)]) * 0.5).normalized());
+      const Index id = static_cast<Index>(v.size() - 1);
+      mid[{key.first, key.second}] = id;
+      return id;
+    };
+    for (const Face& t : f) {
+      const Index a = midpoint(t[0], t[1]), b = midpoint(t[1], t[2]), c = midpoint(t[2], t[0]);
+      nf.push_back({t[0], a, c});
+      nf.push_back({t[1], b, a});
+      nf.push_back({t[2], c, b});
+      nf.push_back({a, b, c});
+    }
+    f = std::move(nf);
+  }
+  auto topo = std::make_shared<Topology>();
+  topo->num_vertices = static_cast<Index>(v.size());
+  topo->faces = f;
+  Object o;
+  o.name = name;
+  o.topology = topo;
+  for (const Vec3& p : v) o.positions.push_back(center + p.normalized() * r * (1 + rng.uniform(-jitter, jitter)));
+  return o;
+}
+
+/// A frame of `n` blobs in a box of side ~ `spread`; some overlap, some are far apart.
+inline Frame make_random_frame(std::uint64_t seed, int n, double spread, int levels = 1) {
+  Rng rng(seed);
+  Frame frame;
+  for (int i = 0; i < n; ++i) {
+    const Vec3 c(rng.uniform(0, spread), rng.uniform(0, spread), rng.uniform(0, spread));
+    frame.objects.push_back(make_blob(rng, c, rng.uniform(0.3, 1.0), levels, 0.3, "blob" + std::to_string(i)));
+  }
+  return frame;
+}
+
+/// A random triangle soup object (no shared vertices), `n` triangles of size ~ `size`.
+inline Object make_soup(Rng& rng, const Vec3& center, double extent, double size, int n,
+                        const std::string& name) {
+  auto topo = std::make_shared<Topology>();
+  Object o;
+  o.name = name;
+  for (int t = 0; t < n; ++t) {
+    const Vec3 c = center + Vec3(rng.uniform(-extent, extent), rng.uniform(-extent, extent),
+                                 rng.uniform(-extent, extent));
+    const Index base = static_cast<Index>(o.positions.size());
+    for (int k = 0; k < 3; ++k)
+      o.positions.push_back(c + Vec3(rng.uniform(-size, size), rng.uniform(-size, size), rng.uniform(-size, size)));
+    topo->faces.push_back({base, base + 1, base + 2});
+  }
+  topo->num_vertices = static_cast<Index>(o.positions.size());
+  o.topology = topo;
+  return o;
+}
+
+}  // namespace vproxq::test
