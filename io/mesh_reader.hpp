@@ -1,0 +1,29 @@
+#pragma once
+// Reading one mesh file into named groups of triangles, keeping the file's own indices.
+#include "core/types.hpp"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace vproxq {
+
+/// One mesh of a file (an OBJ o/g group, a PLY file, an assimp mesh): vertices in file order
+/// (only those its faces use, when the file holds several groups) and faces re-indexed into them.
+struct MeshGroup {
+  std::string name;
+  std::vector<Vec3> positions;
+  std::vector<Face> faces;
+};
+
+/// Reads OBJ and PLY (ASCII and binary) with the project's own index-preserving, double
+/// precision readers; other formats through assimp (float precision, see README). Polygons
+/// are fan-triangulated. No welding, no reordering, no removal of degenerate faces.
+/// Throws InputError naming the file and the problem.
+std::vector<MeshGroup> read_mesh_file(const std::filesystem::path& file);
+
+/// Splits one group into its connected components (faces sharing a vertex), in order of
+/// their first face; each component keeps its vertices in file order.
+std::vector<MeshGroup> split_components(const MeshGroup& group);
+
+}  // namespace vproxq

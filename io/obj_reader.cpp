@@ -1,0 +1,274 @@
+#include "io/obj_reader.hpp"
+
+#include "io/read_util.hpp"
+
+#include <algorithm>
+#include <array>
+#include <limits>
+#include <string>
+#include <string_view>
+
+namespace vproxq::io_detail {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Statements that carry no geometry we use. Listed so that anything else can be reported as
+/// an error (a misnamed or corrupt file should not silently read as an empty mesh).
+constexpr std::array<std::string_view, 31> kIgnoredStatements = {
+    "vt",       "vn",       "vp",   "l",      "p",      "s",          "usemtl",   "mtllib",
+    "cstype",   "deg",      "bmat", "step",   "curv",   "curv2",      "surf",     "parm",
+    "trim",     "hole",     "scrv", "sp",     "end",    "con",        "mg",       "bevel",
+    "c_interp", "d_interp", "lod",  "maplib", "usemap", "shadow_obj", "trace_obj"};
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+
+/// Splits off the next whitespace-separated token of `rest` (empty when none is left).
+std::string_view next_token(std::string_view& rest) {
+  std::size_t b = 0;
+  while (b < rest.size() && is_space(rest[b])) ++b;
+  std::size_t e = b;
+  while (e < rest.size() && !is_space(rest[e])) ++e;
+  const std::string_view tok = rest.substr(b, e - b);
+  rest.remove_prefix(e);
+  return tok;
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+bool is_comment(std::string_view tok) { return !tok.empty() && tok.front() == '#'; }
+
+/// Calls f(line_number, line) for every line of `text` ('\n' or "\r\n" endings).
+template <class F>
+void for_each_line(const std::string& text, F&& f) {
+  std::size_t pos = 0;
+  long line_no = 0;
+  while (pos < text.size()) {
+    std::size_t nl = text.find('\n', pos);
+    if (nl == std::string::npos) nl = text.size();
+    std::string_view line(text.data() + pos, nl - pos);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    f(++line_no, line);
+    pos = nl + 1;
+  }
+}
+
+/// First keyword of a line, or empty for blank lines.
+std::string_view keyword(std::string_view line) { return next_token(line); }
+
+struct RawGroup {
+  std::string name;         ///< empty: unnamed
+  std::vector<Face> faces;  ///< global (file) vertex indices
+};
+
+class ObjParser {
+ public:
+  ObjParser(const fs::path& file, const std::string& text) : file_(file), text_(text) {}
+
+  void parse() {
+    count_vertices();
+    positions_.reserve(static_cast<std::size_t>(total_vertices_));
+    groups_.emplace_back();  // faces before any o/g
+    for_each_line(text_, [this](long line_no, std::string_view line) {
+      line_no_ = line_no;
+      parse_line(line);
+    });
+  }
+
+  std::vector<MeshGroup> result(ObjGroups mode) {
+    std::vector<RawGroup*> with_faces;
+    for (RawGroup& g : groups_) {
+      if (!g.faces.empty()) with_faces.push_back(&g);
+    }
+    const std::string stem = file_.stem().string();
+    std::vector<MeshGroup> out;
+    if (mode == ObjGroups::Merge || with_faces.size() <= 1) {
+      MeshGroup one;
+      one.name =
+          (with_faces.size() == 1 && !with_faces[0]->name.empty() && mode == ObjGroups::Split)
+              ? with_faces[0]->name
+              : stem;
+      one.positions = std::move(positions_);
+      // Groups follow each other in the file, so concatenating them keeps file order.
+      std::size_t n = 0;
+      for (const RawGroup* g : with_faces) n += g->faces.size();
+      one.faces.reserve(n);
+      for (const RawGroup* g : with_faces) {
+        one.faces.insert(one.faces.end(), g->faces.begin(), g->faces.end());
+      }
+      out.push_back(std::move(one));
+      return out;
+    }
+    // Several groups: each keeps the vertices its faces use, in global order. `local` maps a
+    // global index to the group's own; it is reset after each group, so the work is
+    // proportional to the face corners, not groups x vertices.
+    std::vector<Index> local(positions_.size(), kNoIndex);
+    std::vector<Index> used;
+    for (std::size_t k = 0; k < with_faces.size(); ++k) {
+      RawGroup& g = *with_faces[k];
+      used.clear();
+      for (const Face& f : g.faces) used.insert(used.end(), f.begin(), f.end());
+      std::sort(used.begin(), used.end());
+      used.erase(std::unique(used.begin(), used.end()), used.end());
+      MeshGroup mg;
+      mg.name = g.name.empty() ? stem + "_" + std::to_string(k) : g.name;
+      mg.positions.reserve(used.size());
+      for (std::size_t i = 0; i < used.size(); ++i) {
+        local[static_cast<std::size_t>(used[i])] = static_cast<Index>(i);
+        mg.positions.push_back(positions_[static_cast<std::size_t>(used[i])]);
+      }
+      mg.faces.reserve(g.faces.size());
+      for (const Face& f : g.faces) {
+        mg.faces.push_back({local[static_cast<std::size_t>(f[0])],
+                            local[static_cast<std::size_t>(f[1])],
+                            local[static_cast<std::size_t>(f[2])]});
+      }
+      for (Index v : used) local[static_cast<std::size_t>(v)] = kNoIndex;
+      out.push_back(std::move(mg));
+    }
+    return out;
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& what) const {
+    throw_input_error(file_, "line " + std::to_string(line_no_) + ": " + what);
+  }
+
+  /// Positive face indices are checked against the file's total vertex count, so count the
+  /// `v` lines first (a cheap scan; the second pass parses them).
+  void count_vertices() {
+    long long n = 0;
+    for_each_line(text_, [&n](long, std::string_view line) {
+      if (keyword(line) == "v") ++n;
+    });
+    if (n > std::numeric_limits<Index>::max()) {
+      throw_input_error(file_, "too many vertices (" + std::to_string(n) + "), at most " +
+                                   std::to_string(std::numeric_limits<Index>::max()) +
+                                   " are supported");
+    }
+    total_vertices_ = static_cast<Index>(n);
+  }
+
+  void parse_line(std::string_view line) {
+    std::string_view rest = line;
+    const std::string_view kw = next_token(rest);
+    if (kw.empty() || is_comment(kw)) return;
+    if (!trim(rest).empty() && trim(rest).back() == '\\' && kw != "o" && kw != "g") {
+      fail("line continuation with '\\' is not supported");
+    }
+    if (kw == "v") return parse_vertex(rest);
+    if (kw == "f") return parse_face(rest);
+    if (kw == "o" || kw == "g") {
+      groups_.emplace_back();
+      groups_.back().name = std::string(trim(rest));
+      return;
+    }
+    if (std::find(kIgnoredStatements.begin(), kIgnoredStatements.end(), kw) !=
+        kIgnoredStatements.end()) {
+      return;
+    }
+    fail("unknown statement '" + abbreviate(kw) + "'");
+  }
+
+  void parse_vertex(std::string_view rest) {
+    // x y z, then optionally w (rational weight) or r g b [a] (vertex colour): ignored.
+    constexpr int kMaxNumbers = 7;
+    Vec3 p;
+    int n = 0;
+    for (std::string_view tok = next_token(rest); !tok.empty() && !is_comment(tok);
+         tok = next_token(rest)) {
+      double value = 0;
+      if (!parse_double(tok, value)) {
+        fail("malformed vertex: '" + abbreviate(tok) + "' is not a number");
+      }
+      if (n < 3) p[n] = value;
+      if (++n > kMaxNumbers) fail("malformed vertex: too many numbers");
+    }
+    if (n < 3) {
+      fail("malformed vertex: expected 3 coordinates, got " + std::to_string(n));
+    }
+    const int bad = first_non_finite_axis(p);
+    if (bad >= 0) {
+      fail("vertex " + std::to_string(positions_.size() + 1) + " has a non-finite coordinate (" +
+           axis_name(bad) + " = " + std::to_string(p[bad]) + ")");
+    }
+    positions_.push_back(p);
+  }
+
+  /// Resolves one face corner `i[/t[/n]]` to a 0-based global vertex index.
+  Index parse_corner(std::string_view tok) {
+    std::array<std::string_view, 3> parts{};
+    std::size_t count = 0;
+    for (;;) {
+      const std::size_t slash = tok.find('/');
+      if (count == parts.size()) fail("malformed face corner (too many '/')");
+      parts[count++] = tok.substr(0, slash);
+      if (slash == std::string_view::npos) break;
+      tok.remove_prefix(slash + 1);
+    }
+    long long idx = 0;
+    if (!parse_integer(parts[0], idx)) {
+      fail("malformed face corner: vertex index '" + abbreviate(parts[0]) + "' is not an integer");
+    }
+    for (std::size_t i = 1; i < count; ++i) {
+      long long unused = 0;
+      if (!parts[i].empty() && !parse_integer(parts[i], unused)) {
+        fail("malformed face corner: '" + abbreviate(parts[i]) + "' is not an integer");
+      }
+    }
+    if (count == 2 && parts[1].empty()) fail("malformed face corner: empty texture index");
+    if (idx == 0) fail("face index 0 is invalid (OBJ indices start at 1)");
+    if (idx > 0) {
+      if (idx > total_vertices_) {
+        fail("face index " + std::to_string(idx) + " out of range (file has " +
+             std::to_string(total_vertices_) + " vertices)");
+      }
+      return static_cast<Index>(idx - 1);
+    }
+    const long long resolved = static_cast<long long>(positions_.size()) + idx;
+    if (resolved < 0) {
+      fail("face index " + std::to_string(idx) + " out of range (relative index; only " +
+           std::to_string(positions_.size()) + " vertices are defined before this line)");
+    }
+    return static_cast<Index>(resolved);
+  }
+
+  void parse_face(std::string_view rest) {
+    corners_.clear();
+    for (std::string_view tok = next_token(rest); !tok.empty() && !is_comment(tok);
+         tok = next_token(rest)) {
+      corners_.push_back(parse_corner(tok));
+    }
+    if (corners_.size() < 3) {
+      fail("face with " + std::to_string(corners_.size()) + " vertices (a face needs at least 3)");
+    }
+    std::vector<Face>& faces = groups_.back().faces;
+    for (std::size_t i = 1; i + 1 < corners_.size(); ++i) {
+      faces.push_back({corners_[0], corners_[i], corners_[i + 1]});
+    }
+  }
+
+  const fs::path& file_;
+  const std::string& text_;
+  long line_no_ = 0;
+  Index total_vertices_ = 0;
+  std::vector<Vec3> positions_;
+  std::vector<RawGroup> groups_;
+  std::vector<Index> corners_;
+};
+
+}  // namespace
+
+std::vector<MeshGroup> read_obj(const fs::path& file, ObjGroups groups) {
+  const std::string text = read_whole_file(file);
+  ObjParser parser(file, text);
+  parser.parse();
+  return parser.result(groups);
+}
+
+}  // namespace vproxq::io_detail

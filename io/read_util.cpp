@@ -1,0 +1,92 @@
+#include "io/read_util.hpp"
+
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <system_error>
+
+namespace vproxq::io_detail {
+
+namespace fs = std::filesystem;
+
+void throw_input_error(const fs::path& file, const std::string& what) {
+  throw InputError(file.string() + ": " + what);
+}
+
+void require_regular_file(const fs::path& file) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(file, ec);
+  if (ec || !fs::exists(st)) throw_input_error(file, "file not found");
+  if (!fs::is_regular_file(st)) throw_input_error(file, "is not a regular file");
+}
+
+std::string read_whole_file(const fs::path& file) {
+  require_regular_file(file);
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw_input_error(file, std::string("cannot read file (") + std::strerror(errno) + ")");
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size < 0) throw_input_error(file, "cannot read file (cannot determine its size)");
+  in.seekg(0, std::ios::beg);
+  std::string bytes(static_cast<std::size_t>(size), '\0');
+  if (size > 0 && !in.read(bytes.data(), size)) {
+    throw_input_error(file, "cannot read file (read error)");
+  }
+  return bytes;
+}
+
+bool parse_double(std::string_view token, double& out) {
+  // std::from_chars rejects a leading '+', which some writers emit.
+  if (token.size() > 1 && token[0] == '+' && token[1] != '-' && token[1] != '+') {
+    token.remove_prefix(1);
+  }
+  if (token.empty()) return false;
+  const char* end = token.data() + token.size();
+  const auto [ptr, ec] = std::from_chars(token.data(), end, out, std::chars_format::general);
+  // ERANGE: a decimal number outside double's range; report it as non-finite, as it would
+  // be as a coordinate anyway (from_chars leaves `out` unchanged in that case).
+  if (ec == std::errc::result_out_of_range && ptr == end) {
+    out = std::numeric_limits<double>::infinity();
+    return true;
+  }
+  return ec == std::errc() && ptr == end;
+}
+
+bool parse_integer(std::string_view token, long long& out) {
+  if (token.size() > 1 && token[0] == '+' && token[1] != '-' && token[1] != '+') {
+    token.remove_prefix(1);
+  }
+  if (token.empty()) return false;
+  const char* end = token.data() + token.size();
+  const auto [ptr, ec] = std::from_chars(token.data(), end, out);
+  return ec == std::errc() && ptr == end;
+}
+
+std::string lower_extension(const fs::path& file) {
+  std::string ext = file.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+const char* axis_name(int axis) {
+  static const char* const kNames[] = {"x", "y", "z"};
+  return kNames[axis];
+}
+
+int first_non_finite_axis(const Vec3& p) {
+  for (int a = 0; a < 3; ++a) {
+    if (!std::isfinite(p[a])) return a;
+  }
+  return -1;
+}
+
+std::string abbreviate(std::string_view s, std::size_t max_chars) {
+  if (s.size() <= max_chars) return std::string(s);
+  return std::string(s.substr(0, max_chars)) + "...";
+}
+
+}  // namespace vproxq::io_detail

@@ -1,0 +1,42 @@
+#pragma once
+// Small helpers shared by the mesh readers (private to io/): whole-file reading, number
+// parsing, and InputError messages that start with the file path.
+#include "core/errors.hpp"
+#include "core/types.hpp"
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+namespace vproxq::io_detail {
+
+/// "<file>: <what>" as an InputError.
+[[noreturn]] void throw_input_error(const std::filesystem::path& file, const std::string& what);
+
+/// The whole file as bytes. Throws InputError "<file>: file not found" / "is not a regular
+/// file" / "cannot read file (<reason>)".
+std::string read_whole_file(const std::filesystem::path& file);
+
+/// Throws InputError unless `file` exists and is a regular file (same messages as above).
+void require_regular_file(const std::filesystem::path& file);
+
+/// Parses all of `token` as a double (decimal or scientific, optional sign, "nan"/"inf"
+/// accepted so the caller can report them). Returns false if `token` is not exactly a number.
+bool parse_double(std::string_view token, double& out);
+
+/// Parses all of `token` as a decimal integer with optional sign. False if not exactly one.
+bool parse_integer(std::string_view token, long long& out);
+
+/// The file's extension, lower case, with the dot (".obj"); empty if none.
+std::string lower_extension(const std::filesystem::path& file);
+
+/// "x", "y" or "z" for axis 0, 1, 2.
+const char* axis_name(int axis);
+
+/// Index of the first non-finite coordinate of `p` (0..2), or -1 if all are finite.
+int first_non_finite_axis(const Vec3& p);
+
+/// `s` shortened to at most `max_chars` characters (with "..." when cut), for messages.
+std::string abbreviate(std::string_view s, std::size_t max_chars = 40);
+
+}  // namespace vproxq::io_detail

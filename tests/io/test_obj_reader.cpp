@@ -1,0 +1,278 @@
+// The OBJ reader: the file's own indices, double precision, groups, and every error case.
+#include "io/mesh_reader.hpp"
+#include "io/obj_reader.hpp"
+#include "io_test_util.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+namespace vproxq {
+namespace {
+
+using test::TempDir;
+
+std::vector<Face> faces(std::initializer_list<Face> f) { return f; }
+
+TEST(ObjReader, SlashFormsQuadsAndWeightsKeepFileIndices) {
+  TempDir dir;
+  const auto file = dir.write("shape.obj",
+                              "# a comment\n"
+                              "mtllib shape.mtl\n"
+                              "v 0 0 0\n"
+                              "v 1 0 0\n"
+                              "v 1 1 0\n"
+                              "v 0 1 0\n"
+                              "v 0.5 0.5 1 1.0\n"      // with w
+                              "v 2 2 2 0.1 0.2 0.3\n"  // with a vertex colour
+                              "vt 0 0\nvt 1 0\nvt 1 1\n"
+                              "vn 0 0 1\n"
+                              "usemtl red\n"
+                              "s off\n"
+                              "f 1 2 3 4\n"  // quad: fan triangulated
+                              "f 1/1 2/2 5/3\n"
+                              "f 2//1 3//1 5//1\n"
+                              "f 3/3/1 4/1/1 5/2/1 # trailing comment\n");
+  const std::vector<MeshGroup> groups = read_mesh_file(file);
+  ASSERT_EQ(groups.size(), 1u);
+  EXPECT_EQ(groups[0].name, "shape");
+  ASSERT_EQ(groups[0].positions.size(), 6u);  // the unused sixth vertex is kept
+  EXPECT_EQ(groups[0].positions[4], Vec3(0.5, 0.5, 1));
+  EXPECT_EQ(groups[0].positions[5], Vec3(2, 2, 2));
+  EXPECT_EQ(groups[0].faces, faces({{0, 1, 2}, {0, 2, 3}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}}));
+}
+
+TEST(ObjReader, NegativeIndicesAreRelativeToVerticesReadSoFar) {
+  TempDir dir;
+  const auto file = dir.write("rel.obj",
+                              "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                              "f -3 -2 -1\n"
+                              "v 0 0 1\n"
+                              "f -4/-1 -1/-2 -2//-1\n"
+                              "f 1 -1 3\n");
+  const auto groups = read_mesh_file(file);
+  ASSERT_EQ(groups.size(), 1u);
+  EXPECT_EQ(groups[0].faces, faces({{0, 1, 2}, {0, 3, 2}, {0, 3, 2}}));
+}
+
+TEST(ObjReader, PolygonsAreFanTriangulated) {
+  TempDir dir;
+  const auto file = dir.write("poly.obj",
+                              "v 0 0 0\nv 1 0 0\nv 2 1 0\nv 1 2 0\nv 0 1 0\n"
+                              "f 1 2 3 4 5\n");
+  EXPECT_EQ(read_mesh_file(file)[0].faces, faces({{0, 1, 2}, {0, 2, 3}, {0, 3, 4}}));
+}
+
+TEST(ObjReader, PositiveIndicesMayReferToLaterVertices) {
+  TempDir dir;
+  const auto file = dir.write("fwd.obj", "f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
+  const auto groups = read_mesh_file(file);
+  EXPECT_EQ(groups[0].faces, faces({{0, 1, 2}}));
+  EXPECT_EQ(groups[0].positions.size(), 3u);
+}
+
+TEST(ObjReader, CoordinatesAreParsedAsDoubles) {
+  TempDir dir;
+  const char* xs[] = {"0.1", "-1.2345678901234567e-300", "123456789.123456789", "+2.5", "1E+10",
+                      "3"};
+  std::string text;
+  for (int i = 0; i < 6; i += 3) {
+    text += std::string("v ") + xs[i] + " " + xs[i + 1] + " " + xs[i + 2] + "\n";
+  }
+  const auto file = dir.write("precise.obj", text);
+  const auto groups = read_mesh_file(file);
+  ASSERT_EQ(groups[0].positions.size(), 2u);
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_EQ(groups[0].positions[static_cast<std::size_t>(i / 3)][i % 3],
+              std::strtod(xs[i], nullptr))
+        << xs[i];
+  }
+}
+
+TEST(ObjReader, CrlfTabsAndBlankLines) {
+  TempDir dir;
+  const auto file = dir.write("crlf.obj", "v\t0 0 0\r\n\r\n  v 1 0 0\r\nv 0 1 0\r\nf\t1 2 3\r\n");
+  const auto groups = read_mesh_file(file);
+  ASSERT_EQ(groups.size(), 1u);
+  EXPECT_EQ(groups[0].positions[1], Vec3(1, 0, 0));
+  EXPECT_EQ(groups[0].faces, faces({{0, 1, 2}}));
+}
+
+TEST(ObjReader, SeveralGroupsGetTheVerticesTheyUseInFileOrder) {
+  TempDir dir;
+  const auto file = dir.write("multi.obj",
+                              "v 0 0 0\n"  // 1
+                              "v 1 0 0\n"  // 2
+                              "v 0 1 0\n"  // 3
+                              "v 5 5 5\n"  // 4: used by no face
+                              "v 2 0 0\n"  // 5
+                              "v 3 0 0\n"  // 6
+                              "v 2 1 0\n"  // 7
+                              "o first\n"
+                              "f 1 2 3\n"
+                              "g empty group\n"  // no faces: dropped
+                              "o second\n"
+                              "f 5 6 7\n"
+                              "f 7 6 2\n");
+  const auto groups = read_mesh_file(file);
+  ASSERT_EQ(groups.size(), 2u);
+  EXPECT_EQ(groups[0].name, "first");
+  EXPECT_EQ(groups[0].positions, (std::vector<Vec3>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
+  EXPECT_EQ(groups[0].faces, faces({{0, 1, 2}}));
+  EXPECT_EQ(groups[1].name, "second");
+  // Global vertices 2, 5, 6, 7 in that order.
+  EXPECT_EQ(groups[1].positions, (std::vector<Vec3>{{1, 0, 0}, {2, 0, 0}, {3, 0, 0}, {2, 1, 0}}));
+  EXPECT_EQ(groups[1].faces, faces({{1, 2, 3}, {3, 2, 0}}));
+}
+
+TEST(ObjReader, UnnamedGroupsAreNamedAfterTheFileStem) {
+  TempDir dir;
+  const auto file = dir.write("parts.obj",
+                              "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                              "f 1 2 3\n"  // before any group
+                              "g\n"
+                              "f 1 2 4\n"
+                              "o named\n"
+                              "f 1 3 4\n");
+  const auto groups = read_mesh_file(file);
+  ASSERT_EQ(groups.size(), 3u);
+  EXPECT_EQ(groups[0].name, "parts_0");
+  EXPECT_EQ(groups[1].name, "parts_1");
+  EXPECT_EQ(groups[2].name, "named");
+  EXPECT_EQ(groups[1].positions, (std::vector<Vec3>{{0, 0, 0}, {1, 0, 0}, {0, 0, 1}}));
+  EXPECT_EQ(groups[1].faces, faces({{0, 1, 2}}));
+}
+
+TEST(ObjReader, OneGroupWithFacesKeepsAllVerticesAndItsName) {
+  TempDir dir;
+  const auto file = dir.write("one.obj",
+                              "o lonely\n"
+                              "v 9 9 9\n"  // isolated, kept
+                              "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                              "f 2 3 4\n"
+                              "g nothing\n");
+  const auto groups = read_mesh_file(file);
+  ASSERT_EQ(groups.size(), 1u);
+  EXPECT_EQ(groups[0].name, "lonely");
+  EXPECT_EQ(groups[0].positions.size(), 4u);
+  EXPECT_EQ(groups[0].faces, faces({{1, 2, 3}}));
+}
+
+TEST(ObjReader, VerticesOnlyGiveOneGroupWithoutFaces) {
+  TempDir dir;
+  const auto file = dir.write("cloud.obj", "v 0 0 0\nv 1 1 1\n");
+  const auto groups = read_mesh_file(file);
+  ASSERT_EQ(groups.size(), 1u);
+  EXPECT_EQ(groups[0].name, "cloud");
+  EXPECT_EQ(groups[0].positions.size(), 2u);
+  EXPECT_TRUE(groups[0].faces.empty());
+}
+
+TEST(ObjReader, MergeModeKeepsEveryVertexInFileOrder) {
+  TempDir dir;
+  const auto file = dir.write("merge.obj",
+                              "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 7 7 7\nv 2 0 0\nv 3 0 0\n"
+                              "o a\nf 1 2 3\no b\nf 5 6 2\n");
+  const auto groups = io_detail::read_obj(file, io_detail::ObjGroups::Merge);
+  ASSERT_EQ(groups.size(), 1u);
+  EXPECT_EQ(groups[0].name, "merge");
+  EXPECT_EQ(groups[0].positions.size(), 6u);
+  EXPECT_EQ(groups[0].faces, faces({{0, 1, 2}, {4, 5, 1}}));
+}
+
+TEST(ObjReader, BunnyFromTestData) {
+  const std::filesystem::path file =
+      std::filesystem::path(VPROXQ_TEST_DATA_DIR) / "meshes/bunny-npm.obj";
+  std::ifstream in(file);
+  std::string line;
+  std::size_t v = 0, f = 0;
+  while (std::getline(in, line)) {
+    if (line.rfind("v ", 0) == 0) ++v;
+    if (line.rfind("f ", 0) == 0) ++f;
+  }
+  const auto groups = read_mesh_file(file);
+  ASSERT_EQ(groups.size(), 1u);
+  EXPECT_EQ(groups[0].name, "bunny");
+  EXPECT_EQ(v, 1839u);
+  EXPECT_EQ(groups[0].positions.size(), v);
+  EXPECT_EQ(groups[0].faces.size(), f);  // all triangles
+  EXPECT_EQ(groups[0].positions[0], Vec3(1.301895, 0.122622, 2.550061));
+}
+
+// ---- errors: the message starts with the file and says what is wrong ----
+
+TEST(ObjReaderErrors, MissingFile) {
+  TempDir dir;
+  const auto file = dir.path() / "nope.obj";
+  EXPECT_INPUT_ERROR(read_mesh_file(file), file.string() + ": file not found");
+}
+
+TEST(ObjReaderErrors, FaceIndexOutOfRange) {
+  TempDir dir;
+  const auto file = dir.write("a_0003.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 812\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(file),
+                     file.string() + ": line 5: face index 812 out of range (file has 3 vertices)");
+}
+
+TEST(ObjReaderErrors, ZeroFaceIndex) {
+  TempDir dir;
+  const auto file = dir.write("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(file), file.string() + ": line 4:", "face index 0");
+}
+
+TEST(ObjReaderErrors, RelativeIndexBeforeTheFirstVertex) {
+  TempDir dir;
+  const auto file = dir.write("rel.obj", "v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(file),
+                     file.string() + ": line 3:", "face index -3 out of range");
+}
+
+TEST(ObjReaderErrors, FaceWithTwoVertices) {
+  TempDir dir;
+  const auto file = dir.write("two.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(file), file.string() + ": line 3:", "face with 2 vertices");
+}
+
+TEST(ObjReaderErrors, MalformedVertex) {
+  TempDir dir;
+  const auto a = dir.write("a.obj", "v 0 zero 0\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(a), a.string() + ": line 1:", "'zero' is not a number");
+  const auto b = dir.write("b.obj", "v 0 0\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(b), b.string() + ": line 1:", "expected 3 coordinates");
+}
+
+TEST(ObjReaderErrors, NonFiniteCoordinateNamesTheVertex) {
+  TempDir dir;
+  const auto a = dir.write("nan.obj", "v 0 0 0\nv 1 nan 0\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(a), a.string() + ": line 2:", "vertex 2", "non-finite",
+                     "y = nan");
+  const auto b = dir.write("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 1 -inf\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(b), b.string() + ": line 3:", "vertex 3", "z = -inf");
+  const auto c = dir.write("huge.obj", "v 1e999 0 0\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(c), c.string() + ": line 1:", "vertex 1", "non-finite");
+}
+
+TEST(ObjReaderErrors, MalformedFaceCorners) {
+  TempDir dir;
+  const auto a = dir.write("a.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1/1 2 3\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(a), a.string() + ": line 4:", "malformed face corner");
+  const auto b = dir.write("b.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf x 2 3\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(b), b.string() + ": line 4:", "'x' is not an integer");
+  const auto c = dir.write("c.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/a 2 3\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(c), c.string() + ": line 4:", "malformed face corner");
+  const auto d = dir.write("d.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1.5 2 3\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(d), d.string() + ": line 4:", "not an integer");
+}
+
+TEST(ObjReaderErrors, UnknownStatementAndLineContinuation) {
+  TempDir dir;
+  const auto a = dir.write("a.obj", "v 0 0 0\nvertex 1 2 3\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(a), a.string() + ": line 2:", "unknown statement 'vertex'");
+  const auto b = dir.write("b.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 \\\n 3\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(b), b.string() + ": line 4:", "line continuation");
+}
+
+}  // namespace
+}  // namespace vproxq
