@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# vproxq against FCL on the paper's "200 objects through a funnel" scene, in one command:
+# installs libfcl-dev if missing (as root or through sudo), configures a Release build with
+# the benchmark into build-bench/, builds it, generates the scene into bench-out/, and runs
+# the benchmark, printing the per-frame table (also saved as bench-out/blobs-200/fcl-bench.txt).
+#
+#   bash scripts/bench.sh                      # 200 blobs x 180 triangles, 5 frames, 2 threads
+#   THREADS=4 REPEAT=5 bash scripts/bench.sh   # environment overrides (see below)
+#   bash scripts/bench.sh --fcl-threads 1      # extra options go to vproxq-bench-fcl
+#
+# Environment: THREADS (2), REPEAT (3), OBJECTS (200), FREQUENCY (3: 180 triangles per blob),
+# FRAMES (5), SEED (1), JOBS (build jobs, default: nproc). The other build dependencies come
+# from scripts/setup.sh.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+threads=${THREADS:-2}
+repeat=${REPEAT:-3}
+objects=${OBJECTS:-200}
+frequency=${FREQUENCY:-3}
+frames=${FRAMES:-5}
+seed=${SEED:-1}
+jobs=${JOBS:-$(nproc 2>/dev/null || echo 2)}
+
+if ! dpkg-query -W -f='${Status}' libfcl-dev 2>/dev/null | grep -q "install ok installed"; then
+  echo "bench.sh: installing libfcl-dev (FCL, the benchmark's peer library)"
+  if [ "$(id -u)" = 0 ]; then
+    sudo=()
+  elif command -v sudo >/dev/null 2>&1; then
+    sudo=(sudo)
+  else
+    echo "bench.sh: need root or sudo to install libfcl-dev (or install it yourself)" >&2
+    exit 1
+  fi
+  export DEBIAN_FRONTEND=noninteractive
+  if ! "${sudo[@]}" apt-get install -y --no-install-recommends libfcl-dev; then
+    "${sudo[@]}" apt-get update
+    "${sudo[@]}" apt-get install -y --no-install-recommends libfcl-dev
+  fi
+fi
+
+cmake -S . -B build-bench -DCMAKE_BUILD_TYPE=Release -DVPROXQ_BUILD_BENCH=ON \
+  -DVPROXQ_BUILD_TESTS=OFF
+cmake --build build-bench --target vproxq-gen vproxq-bench-fcl -j"$jobs"
+
+scene_dir=bench-out/blobs-$objects
+build-bench/sample_scenes/vproxq-gen blobs --objects "$objects" --frequency "$frequency" \
+  --frames "$frames" --seed "$seed" --out "$scene_dir"
+
+echo
+build-bench/bench/vproxq-bench-fcl "$scene_dir/scene.json" --threads "$threads" \
+  --repeat "$repeat" "$@" | tee "$scene_dir/fcl-bench.txt"
