@@ -1,0 +1,398 @@
+#include "io/hdf5_writer.hpp"
+
+#include "core/errors.hpp"
+#include "io/hdf5_util.hpp"
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace vproxq::detail {
+
+namespace {
+
+using h5::Handle;
+
+// In-memory rows of the compound datasets; the file types are packed little-endian copies.
+struct ObjectRow {
+  std::int32_t id;
+  std::int32_t vertices;
+  std::int32_t triangles;
+  std::uint8_t is_static;
+};
+
+struct InterRow {
+  std::int32_t object;
+  std::int32_t nearest_object;
+  double distance;
+  std::int32_t tri_a;
+  std::int32_t tri_b;
+  double point_a[3];
+  double point_b[3];
+  std::uint8_t kind;  // field "case"
+};
+
+// File codes of TriangleDistanceCase, fixed by the file format (not by the enum's order).
+std::uint8_t case_code(TriangleDistanceCase kind) {
+  switch (kind) {
+    case TriangleDistanceCase::Intersecting: return 0;
+    case TriangleDistanceCase::VertexFace: return 1;
+    case TriangleDistanceCase::FaceVertex: return 2;
+    case TriangleDistanceCase::EdgeEdge: return 3;
+  }
+  return kHdf5CaseNone;
+}
+
+std::string frame_group_name(int frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%06d", frame);
+  return name;
+}
+
+std::string join(const std::vector<std::string>& parts, const char* separator) {
+  std::string out;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    if (i > 0) out += separator;
+    out += parts[i];
+  }
+  return out;
+}
+
+}  // namespace
+
+struct Hdf5ResultWriter::Impl {
+  std::string path;
+  Handle file_access;
+  Handle file;
+  Handle frames;
+  int frames_since_open = 0;
+  Handle string_type;
+  Handle object_mem_type, object_file_type;
+  Handle inter_mem_type, inter_file_type;
+  Handle transfer;        ///< dataset transfer list, its buffer sized to each write
+  Handle group_creation;  ///< keeps up to kCompactAttributes attributes in the object header
+
+  // HDF5 keeps bookkeeping for an open file (free-space sections and the like) that grows
+  // with every object written, a few hundred bytes a frame; closing and reopening the file now and
+  // then releases it, so that memory stays flat however many frames a run writes.
+  static constexpr int kFramesPerOpen = 1000;
+
+  void reopen() {
+    close_checked(frames, "H5Gclose", "/frames");
+    close_checked(file, "H5Fclose", "");
+    file = Handle(check_id(H5Fopen(path.c_str(), H5F_ACC_RDWR, file_access.get()), "H5Fopen", ""),
+                  H5Fclose);
+    frames = Handle(check_id(H5Gopen2(file.get(), "frames", H5P_DEFAULT), "H5Gopen2", "/frames"),
+                    H5Gclose);
+    frames_since_open = 0;
+  }
+
+  [[noreturn]] void fail(const char* call, const std::string& object) const {
+    throw RuntimeError("HDF5: " + h5::failure_text(call, path, object));
+  }
+  hid_t check_id(hid_t id, const char* call, const std::string& object) const {
+    if (id < 0) fail(call, object);
+    return id;
+  }
+  void check_ok(herr_t status, const char* call, const std::string& object) const {
+    if (status < 0) fail(call, object);
+  }
+  void close_checked(Handle& handle, const char* call, const std::string& object) const {
+    check_ok(handle.close(), call, object);
+  }
+
+  // One compound member: its name, where it lies in memory, and its memory and file types.
+  struct Member {
+    const char* name;
+    std::size_t offset;
+    hid_t mem_type;
+    hid_t file_type;
+  };
+
+  // Builds the native memory type and the packed file type of one compound row.
+  void build_compound(const std::vector<Member>& members, std::size_t mem_size, Handle& mem,
+                      Handle& packed) const {
+    mem = Handle(check_id(H5Tcreate(H5T_COMPOUND, mem_size), "H5Tcreate", "compound"), H5Tclose);
+    std::size_t file_size = 0;
+    for (const Member& m : members) {
+      check_ok(H5Tinsert(mem.get(), m.name, m.offset, m.mem_type), "H5Tinsert", m.name);
+      file_size += H5Tget_size(m.file_type);
+    }
+    packed = Handle(check_id(H5Tcreate(H5T_COMPOUND, file_size), "H5Tcreate", "compound"),
+                    H5Tclose);
+    std::size_t offset = 0;
+    for (const Member& m : members) {
+      check_ok(H5Tinsert(packed.get(), m.name, offset, m.file_type), "H5Tinsert", m.name);
+      offset += H5Tget_size(m.file_type);
+    }
+  }
+
+  void build_property_lists() {
+    transfer = Handle(check_id(H5Pcreate(H5P_DATASET_XFER), "H5Pcreate", "transfer list"),
+                      H5Pclose);
+    group_creation = Handle(check_id(H5Pcreate(H5P_GROUP_CREATE), "H5Pcreate", "group list"),
+                            H5Pclose);
+    // The stats group has 9 attributes; past HDF5's default of 8 each group would get its own
+    // dense attribute storage (a fractal heap and a B-tree), slower and larger on disk.
+    constexpr unsigned kCompactAttributes = 16;
+    constexpr unsigned kDenseAttributes = 12;
+    check_ok(H5Pset_attr_phase_change(group_creation.get(), kCompactAttributes, kDenseAttributes),
+             "H5Pset_attr_phase_change", "group list");
+  }
+
+  void build_types() {
+    string_type = h5::vlen_string_type();
+    if (!string_type.valid()) fail("H5Tcopy/H5Tset_size", "variable-length string type");
+
+    build_compound({{"id", offsetof(ObjectRow, id), H5T_NATIVE_INT32, H5T_STD_I32LE},
+                    {"vertices", offsetof(ObjectRow, vertices), H5T_NATIVE_INT32, H5T_STD_I32LE},
+                    {"triangles", offsetof(ObjectRow, triangles), H5T_NATIVE_INT32,
+                     H5T_STD_I32LE},
+                    {"is_static", offsetof(ObjectRow, is_static), H5T_NATIVE_UINT8, H5T_STD_U8LE}},
+                   sizeof(ObjectRow), object_mem_type, object_file_type);
+
+    const hsize_t three[1] = {3};
+    Handle point_mem(check_id(H5Tarray_create2(H5T_NATIVE_DOUBLE, 1, three), "H5Tarray_create2",
+                              "point type"),
+                     H5Tclose);
+    Handle point_file(check_id(H5Tarray_create2(H5T_IEEE_F64LE, 1, three), "H5Tarray_create2",
+                               "point type"),
+                      H5Tclose);
+    build_compound(
+        {{"object", offsetof(InterRow, object), H5T_NATIVE_INT32, H5T_STD_I32LE},
+         {"nearest_object", offsetof(InterRow, nearest_object), H5T_NATIVE_INT32, H5T_STD_I32LE},
+         {"distance", offsetof(InterRow, distance), H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE},
+         {"tri_a", offsetof(InterRow, tri_a), H5T_NATIVE_INT32, H5T_STD_I32LE},
+         {"tri_b", offsetof(InterRow, tri_b), H5T_NATIVE_INT32, H5T_STD_I32LE},
+         {"point_a", offsetof(InterRow, point_a), point_mem.get(), point_file.get()},
+         {"point_b", offsetof(InterRow, point_b), point_mem.get(), point_file.get()},
+         {"case", offsetof(InterRow, kind), H5T_NATIVE_UINT8, H5T_STD_U8LE}},
+        sizeof(InterRow), inter_mem_type, inter_file_type);
+  }
+
+  void write_attribute(hid_t owner, const std::string& owner_name, const char* name,
+                       hid_t file_type, hid_t mem_type, const void* value) const {
+    const std::string where = owner_name + "@" + name;
+    Handle space(check_id(H5Screate(H5S_SCALAR), "H5Screate", where), H5Sclose);
+    Handle attr(check_id(H5Acreate2(owner, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+                         "H5Acreate2", where),
+                H5Aclose);
+    check_ok(H5Awrite(attr.get(), mem_type, value), "H5Awrite", where);
+    close_checked(attr, "H5Aclose", where);
+  }
+  void write_attribute(hid_t owner, const std::string& owner_name, const char* name,
+                       const std::string& value) const {
+    const char* text = value.c_str();
+    write_attribute(owner, owner_name, name, string_type.get(), string_type.get(), &text);
+  }
+  void write_attribute(hid_t owner, const std::string& owner_name, const char* name,
+                       std::int32_t value) const {
+    write_attribute(owner, owner_name, name, H5T_STD_I32LE, H5T_NATIVE_INT32, &value);
+  }
+  void write_attribute(hid_t owner, const std::string& owner_name, const char* name,
+                       std::uint64_t value) const {
+    write_attribute(owner, owner_name, name, H5T_STD_U64LE, H5T_NATIVE_UINT64, &value);
+  }
+  void write_attribute(hid_t owner, const std::string& owner_name, const char* name,
+                       double value) const {
+    write_attribute(owner, owner_name, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value);
+  }
+  // A 1-D array of strings (possibly empty).
+  void write_attribute(hid_t owner, const std::string& owner_name, const char* name,
+                       const std::vector<std::string>& values) const {
+    const std::string where = owner_name + "@" + name;
+    std::vector<const char*> texts;
+    texts.reserve(values.size());
+    for (const std::string& v : values) texts.push_back(v.c_str());
+    const hsize_t n[1] = {values.size()};
+    Handle space(check_id(H5Screate_simple(1, n, nullptr), "H5Screate_simple", where), H5Sclose);
+    Handle attr(check_id(H5Acreate2(owner, name, string_type.get(), space.get(), H5P_DEFAULT,
+                                    H5P_DEFAULT),
+                         "H5Acreate2", where),
+                H5Aclose);
+    if (!texts.empty()) {
+      check_ok(H5Awrite(attr.get(), string_type.get(), texts.data()), "H5Awrite", where);
+    }
+    close_checked(attr, "H5Aclose", where);
+  }
+
+  // A 1-D dataset of `rows` elements (possibly none).
+  void write_dataset(hid_t parent, const std::string& parent_name, const char* name,
+                     hid_t file_type, hid_t mem_type, std::size_t rows, const void* data) const {
+    const std::string where = parent_name + "/" + name;
+    const hsize_t n[1] = {rows};
+    Handle space(check_id(H5Screate_simple(1, n, nullptr), "H5Screate_simple", where), H5Sclose);
+    Handle dataset(check_id(H5Dcreate2(parent, name, file_type, space.get(), H5P_DEFAULT,
+                                       H5P_DEFAULT, H5P_DEFAULT),
+                            "H5Dcreate2", where),
+                   H5Dclose);
+    if (rows > 0) {
+      // HDF5 otherwise allocates and zeroes its default 1 MiB conversion buffer on every
+      // write, which dominated the time of a frame; a buffer of the data's size suffices
+      // (HDF5 converts in strips when it is smaller). The floor covers elements that are
+      // larger on the way to disk than H5Tget_size says (a variable-length string: 8 vs 16).
+      constexpr std::size_t kMinTransferBuffer = 4096;
+      const std::size_t row_bytes = std::max(H5Tget_size(mem_type), H5Tget_size(file_type));
+      check_ok(H5Pset_buffer(transfer.get(), std::max(rows * row_bytes, kMinTransferBuffer),
+                             nullptr, nullptr),
+               "H5Pset_buffer", where);
+      check_ok(H5Dwrite(dataset.get(), mem_type, H5S_ALL, H5S_ALL, transfer.get(), data),
+               "H5Dwrite", where);
+    }
+    close_checked(dataset, "H5Dclose", where);
+  }
+
+  Handle create_group(hid_t parent, const char* name, const std::string& where) const {
+    return Handle(
+        check_id(H5Gcreate2(parent, name, H5P_DEFAULT, group_creation.get(), H5P_DEFAULT),
+                 "H5Gcreate2", where),
+        H5Gclose);
+  }
+
+  void write_objects(hid_t group, const std::string& where, const FrameResult& frame) const {
+    std::vector<ObjectRow> rows;
+    std::vector<const char*> names;
+    rows.reserve(frame.objects.size());
+    names.reserve(frame.objects.size());
+    for (const ObjectInfo& o : frame.objects) {
+      ObjectRow row{};
+      row.id = o.id;
+      row.vertices = o.vertices;
+      row.triangles = o.triangles;
+      row.is_static = o.is_static ? 1 : 0;
+      rows.push_back(row);
+      names.push_back(o.name.c_str());
+    }
+    write_dataset(group, where, "objects", object_file_type.get(), object_mem_type.get(),
+                  rows.size(), rows.data());
+    write_dataset(group, where, "object_names", string_type.get(), string_type.get(),
+                  names.size(), names.data());
+  }
+
+  void write_inter(hid_t group, const std::string& where,
+                   const std::vector<InterObjectDistance>& inter) const {
+    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+    std::vector<InterRow> rows;
+    rows.reserve(inter.size());
+    for (const InterObjectDistance& d : inter) {
+      InterRow row{};
+      row.object = d.object;
+      if (d.has_nearest()) {
+        row.nearest_object = d.nearest_object;
+        row.distance = d.distance;
+        row.tri_a = d.triangles[0];
+        row.tri_b = d.triangles[1];
+        for (int k = 0; k < 3; ++k) {
+          row.point_a[k] = d.points[0][k];
+          row.point_b[k] = d.points[1][k];
+        }
+        row.kind = case_code(d.kind);
+      } else {
+        row.nearest_object = kNoIndex;
+        row.distance = kInfinity;
+        row.tri_a = kNoIndex;
+        row.tri_b = kNoIndex;
+        for (int k = 0; k < 3; ++k) row.point_a[k] = row.point_b[k] = kNaN;
+        row.kind = kHdf5CaseNone;
+      }
+      rows.push_back(row);
+    }
+    const std::string dist_where = where + "/distance";
+    Handle distance = create_group(group, "distance", dist_where);
+    write_dataset(distance.get(), dist_where, "inter", inter_file_type.get(),
+                  inter_mem_type.get(), rows.size(), rows.data());
+    close_checked(distance, "H5Gclose", dist_where);
+  }
+
+  void write_stats(hid_t group, const std::string& where, const FrameResult& frame,
+                   double write_ms) const {
+    const std::string stats_where = where + "/stats";
+    Handle stats = create_group(group, "stats", stats_where);
+    const hid_t s = stats.get();
+    const StageTimes& t = frame.time_ms;
+    write_attribute(s, stats_where, "time_ms_load", t.load);
+    write_attribute(s, stats_where, "time_ms_aabb", t.aabb);
+    write_attribute(s, stats_where, "time_ms_voronoi", t.voronoi);
+    write_attribute(s, stats_where, "time_ms_exact", t.exact);
+    write_attribute(s, stats_where, "time_ms_write", write_ms);
+    write_attribute(s, stats_where, "time_ms_total", t.total);
+    write_attribute(s, stats_where, "exact_tests", std::uint64_t{frame.counters.exact_tests});
+    write_attribute(s, stats_where, "pns_pairs", std::uint64_t{frame.counters.object_pns_pairs});
+    write_attribute(s, stats_where, "candidate_pairs",
+                    std::uint64_t{frame.counters.candidate_pairs});
+    close_checked(stats, "H5Gclose", stats_where);
+  }
+};
+
+Hdf5ResultWriter::Hdf5ResultWriter(const std::filesystem::path& file, const RunInfo& info)
+    : impl_(std::make_unique<Impl>()) {
+  h5::QuietErrors quiet;
+  Impl& m = *impl_;
+  m.path = file.string();
+  m.build_types();
+  m.build_property_lists();
+  // The HDF5 1.8 file format (read by every HDF5 since 1.8, h5py and h5dump included): a
+  // small group keeps its links in its object header instead of a B-tree and heap of its
+  // own, which makes the per-frame groups about a third smaller on disk.
+  m.file_access = Handle(m.check_id(H5Pcreate(H5P_FILE_ACCESS), "H5Pcreate", ""), H5Pclose);
+  m.check_ok(H5Pset_libver_bounds(m.file_access.get(), H5F_LIBVER_V18, H5F_LIBVER_V18),
+             "H5Pset_libver_bounds", "");
+  m.file = Handle(
+      m.check_id(H5Fcreate(m.path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, m.file_access.get()),
+                 "H5Fcreate", ""),
+      H5Fclose);
+  const hid_t root = m.file.get();
+  m.write_attribute(root, "/", "tool", std::string("vproxq"));
+  m.write_attribute(root, "/", "version", info.tool_version);
+  m.write_attribute(root, "/", "format_version", std::int32_t{kFormatVersion});
+  m.write_attribute(root, "/", "scene", info.scene_name);
+  m.write_attribute(root, "/", "scene_path", info.scene);
+  m.write_attribute(root, "/", "queries", join(info.queries, ","));
+  m.write_attribute(root, "/", "voronoi", info.voronoi);
+  m.write_attribute(root, "/", "grid", std::int32_t{info.grid});
+  m.write_attribute(root, "/", "device", info.device);
+  m.write_attribute(root, "/", "threads", std::int32_t{info.threads});
+  m.frames = m.create_group(root, "frames", "/frames");
+}
+
+double Hdf5ResultWriter::write_frame(const FrameResult& frame,
+                                     std::chrono::steady_clock::time_point started) {
+  h5::QuietErrors quiet;
+  Impl& m = *impl_;
+  if (!m.frames.valid()) throw RuntimeError("HDF5: '" + m.path + "' is already closed");
+  if (m.frames_since_open == Impl::kFramesPerOpen) m.reopen();
+  ++m.frames_since_open;
+  const std::string name = frame_group_name(frame.frame);
+  const std::string where = "/frames/" + name;
+  Handle group = m.create_group(m.frames.get(), name.c_str(), where);
+  m.write_attribute(group.get(), where, "frame", std::int32_t{frame.frame});
+  m.write_attribute(group.get(), where, "files", frame.files);
+  m.write_objects(group.get(), where, frame);
+  if (frame.inter) m.write_inter(group.get(), where, *frame.inter);
+
+  const double write_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started)
+          .count();
+  m.write_stats(group.get(), where, frame, write_ms);
+  m.close_checked(group, "H5Gclose", where);
+  return write_ms;
+}
+
+void Hdf5ResultWriter::close() {
+  h5::QuietErrors quiet;
+  Impl& m = *impl_;
+  m.close_checked(m.frames, "H5Gclose", "/frames");
+  m.close_checked(m.file, "H5Fclose", "");
+}
+
+Hdf5ResultWriter::~Hdf5ResultWriter() {
+  if (!impl_) return;
+  h5::QuietErrors quiet;
+  impl_->frames.close();
+  impl_->file.close();
+}
+
+}  // namespace vproxq::detail

@@ -1,0 +1,180 @@
+#include "io/json_writer.hpp"
+
+#include "core/errors.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+
+#include <unistd.h>
+
+namespace vproxq::detail {
+
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+Json point_json(const Vec3& p) { return Json::array({p.x(), p.y(), p.z()}); }
+
+Json inter_json(const InterObjectDistance& d) {
+  Json r;
+  r["object"] = d.object;
+  if (d.has_nearest()) {
+    r["nearest_object"] = d.nearest_object;
+    r["distance"] = d.distance;
+    r["triangles"] = Json::array({d.triangles[0], d.triangles[1]});
+    r["points"] = Json::array({point_json(d.points[0]), point_json(d.points[1])});
+  } else {
+    r["nearest_object"] = nullptr;
+    r["distance"] = nullptr;
+    r["triangles"] = nullptr;
+    r["points"] = nullptr;
+  }
+  return r;
+}
+
+// True when format_json spreads `value` over several lines.
+bool spreads(const Json& value) {
+  if (value.is_array()) {
+    return std::any_of(value.begin(), value.end(), [](const Json& e) { return e.is_object(); });
+  }
+  if (value.is_object()) {
+    return std::any_of(value.begin(), value.end(), [](const Json& e) { return spreads(e); });
+  }
+  return false;
+}
+
+std::string compact(const Json& value) {
+  return value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+// `spread` forces the top level of `value` onto several lines (used for each frame).
+void format_into(std::string& out, const Json& value, int indent, bool spread = false) {
+  if (!spread && !spreads(value)) {
+    out += compact(value);
+    return;
+  }
+  const std::string inner(static_cast<std::size_t>(indent + 1), ' ');
+  const bool object = value.is_object();
+  out += object ? "{\n" : "[\n";
+  bool first = true;
+  for (auto it = value.begin(); it != value.end(); ++it) {
+    if (!first) out += ",\n";
+    first = false;
+    out += inner;
+    if (object) {
+      out += compact(Json(it.key()));
+      out += ": ";
+    }
+    format_into(out, it.value(), indent + 1);
+  }
+  out += '\n';
+  out += std::string(static_cast<std::size_t>(indent), ' ');
+  out += object ? '}' : ']';
+}
+
+}  // namespace
+
+Json run_header_json(const RunInfo& info) {
+  Json j;
+  j["tool"] = "vproxq";
+  j["version"] = info.tool_version;
+  j["format_version"] = kFormatVersion;
+  j["scene"] = info.scene_name;
+  j["queries"] = info.queries;
+  Json settings;
+  settings["voronoi"] = info.voronoi;
+  settings["grid"] = info.grid == 0 ? Json(nullptr) : Json(info.grid);
+  settings["device"] = info.device.empty() ? Json(nullptr) : Json(info.device);
+  settings["threads"] = info.threads;
+  j["settings"] = std::move(settings);
+  return j;
+}
+
+Json frame_json(const FrameResult& frame, double write_ms) {
+  Json j;
+  j["frame"] = frame.frame;
+  Json objects = Json::array();
+  for (const ObjectInfo& o : frame.objects) {
+    Json r;
+    r["id"] = o.id;
+    r["name"] = o.name;
+    r["vertices"] = o.vertices;
+    r["triangles"] = o.triangles;
+    if (o.is_static) r["static"] = true;
+    objects.push_back(std::move(r));
+  }
+  j["objects"] = std::move(objects);
+  if (frame.inter) {
+    Json inter = Json::array();
+    for (const InterObjectDistance& d : *frame.inter) inter.push_back(inter_json(d));
+    j["distance"]["inter"] = std::move(inter);
+  }
+  const StageTimes& t = frame.time_ms;
+  Json time_ms;
+  time_ms["load"] = t.load;
+  time_ms["aabb"] = t.aabb;
+  time_ms["voronoi"] = t.voronoi;
+  time_ms["exact"] = t.exact;
+  time_ms["write"] = write_ms;
+  time_ms["total"] = t.total;
+  Json stats;
+  stats["time_ms"] = std::move(time_ms);
+  stats["exact_tests"] = frame.counters.exact_tests;
+  stats["pns_pairs"] = frame.counters.object_pns_pairs;
+  stats["candidate_pairs"] = frame.counters.candidate_pairs;
+  j["stats"] = std::move(stats);
+  return j;
+}
+
+std::string format_json(const Json& value, int indent) {
+  std::string out;
+  format_into(out, value, indent);
+  return out;
+}
+
+JsonResultStream::JsonResultStream(const std::filesystem::path& file, const RunInfo& info)
+    : path_(file) {
+  file_.reset(std::fopen(path_.c_str(), "wb"));
+  if (!file_) fail("cannot create", errno);
+  std::string header = "{\n";
+  const Json head = run_header_json(info);
+  for (auto it = head.begin(); it != head.end(); ++it) {
+    header += ' ';
+    header += compact(Json(it.key()));
+    header += ": ";
+    format_into(header, it.value(), 1);
+    header += ",\n";
+  }
+  header += " \"frames\": [";
+  put(header);
+}
+
+void JsonResultStream::write_frame(const FrameResult& frame, double write_ms) {
+  std::string text = frames_written_ == 0 ? "\n  " : ",\n  ";
+  format_into(text, frame_json(frame, write_ms), 2, /*spread=*/true);
+  put(text);
+  ++frames_written_;
+}
+
+void JsonResultStream::close() {
+  put(frames_written_ == 0 ? "]\n}\n" : "\n ]\n}\n");
+  if (std::fflush(file_.get()) != 0) fail("cannot write", errno);
+  if (::fsync(::fileno(file_.get())) != 0) fail("cannot sync", errno);
+  if (std::fclose(file_.release()) != 0) fail("cannot close", errno);
+}
+
+JsonResultStream::~JsonResultStream() = default;
+
+void JsonResultStream::put(const std::string& text) {
+  if (!file_) throw RuntimeError("'" + path_.string() + "' is already closed");
+  if (std::fwrite(text.data(), 1, text.size(), file_.get()) != text.size()) {
+    fail("cannot write", errno);
+  }
+}
+
+void JsonResultStream::fail(const char* what, int error) const {
+  throw RuntimeError(std::string(what) + " '" + path_.string() + "': " + std::strerror(error));
+}
+
+}  // namespace vproxq::detail

@@ -1,0 +1,142 @@
+#include "io/output.hpp"
+
+#include "core/errors.hpp"
+#include "io/hdf5_writer.hpp"
+#include "io/json_writer.hpp"
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <optional>
+#include <string>
+#include <system_error>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+namespace vproxq {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A temporary file name that is removed on destruction unless it was moved into place.
+class TempPath {
+ public:
+  explicit TempPath(fs::path path) : path_(std::move(path)) {}
+  ~TempPath() {
+    if (!path_.empty()) {
+      std::error_code ignored;
+      fs::remove(path_, ignored);
+    }
+  }
+  TempPath(const TempPath&) = delete;
+  TempPath& operator=(const TempPath&) = delete;
+
+  const fs::path& path() const { return path_; }
+
+  /// Atomically replaces `target` with this file (rename(2)); afterwards nothing is removed.
+  void move_to(const fs::path& target) {
+    std::error_code ec;
+    fs::rename(path_, target, ec);
+    if (ec) {
+      throw RuntimeError("cannot rename '" + path_.string() + "' to '" + target.string() +
+                         "': " + ec.message());
+    }
+    path_.clear();
+  }
+
+ private:
+  fs::path path_;
+};
+
+fs::path temp_name(const fs::path& dir, const char* final_name) {
+  return dir / ("." + std::string(final_name) + ".tmp-" + std::to_string(::getpid()));
+}
+
+fs::path prepare_dir(const fs::path& out_dir) {
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec) {
+    throw RuntimeError("cannot create output directory '" + out_dir.string() +
+                       "': " + ec.message());
+  }
+  if (!fs::is_directory(out_dir, ec)) {
+    throw RuntimeError("output path '" + out_dir.string() + "' is not a directory");
+  }
+  return out_dir;
+}
+
+// Flushes a closed file's data to disk, so that a rename never exposes an incomplete file
+// after a crash.
+void sync_file(const fs::path& file) {
+  const int fd = ::open(file.c_str(), O_RDONLY);
+  if (fd < 0 || ::fsync(fd) != 0) {
+    const int error = errno;
+    if (fd >= 0) ::close(fd);
+    throw RuntimeError("cannot sync '" + file.string() + "': " + std::strerror(error));
+  }
+  ::close(fd);
+}
+
+constexpr const char* kJsonName = "results.json";
+constexpr const char* kHdf5Name = "results.h5";
+
+}  // namespace
+
+// Members are declared so that, whatever throws, the open files are closed before their
+// temporaries are removed (members are destroyed in reverse order).
+struct ResultWriter::Impl {
+  explicit Impl(const fs::path& out_dir, const RunInfo& info)
+      : dir(prepare_dir(out_dir)),
+        json_temp(temp_name(dir, kJsonName)),
+        h5_temp(temp_name(dir, kHdf5Name)),
+        json(std::in_place, json_temp.path(), info),
+        h5(std::in_place, h5_temp.path(), info) {}
+
+  fs::path dir;
+  TempPath json_temp;
+  TempPath h5_temp;
+  std::optional<detail::JsonResultStream> json;
+  std::optional<detail::Hdf5ResultWriter> h5;
+  bool failed = false;     ///< a write threw: the files may be inconsistent, never commit them
+  bool committed = false;
+};
+
+ResultWriter::ResultWriter(const fs::path& out_dir, const RunInfo& info)
+    : impl_(std::make_unique<Impl>(out_dir, info)) {}
+
+double ResultWriter::write_frame(const FrameResult& frame) {
+  Impl& m = *impl_;
+  if (m.committed) throw RuntimeError("results in '" + m.dir.string() + "' already committed");
+  if (m.failed) throw RuntimeError("an earlier write to '" + m.dir.string() + "' failed");
+  try {
+    const auto started = std::chrono::steady_clock::now();
+    const double write_ms = m.h5->write_frame(frame, started);
+    m.json->write_frame(frame, write_ms);
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started)
+        .count();
+  } catch (...) {
+    m.failed = true;
+    throw;
+  }
+}
+
+void ResultWriter::commit() {
+  Impl& m = *impl_;
+  if (m.committed) throw RuntimeError("results in '" + m.dir.string() + "' already committed");
+  if (m.failed) throw RuntimeError("an earlier write to '" + m.dir.string() + "' failed");
+  m.failed = true;  // until every step below has succeeded
+  m.json->close();
+  m.h5->close();
+  sync_file(m.h5_temp.path());
+  // results.json last: its presence means that results.h5 of the same run is in place too.
+  m.h5_temp.move_to(m.dir / kHdf5Name);
+  m.json_temp.move_to(m.dir / kJsonName);
+  m.failed = false;
+  m.committed = true;
+}
+
+ResultWriter::~ResultWriter() = default;
+
+}  // namespace vproxq
