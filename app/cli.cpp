@@ -1,0 +1,150 @@
+#include "app/cli.hpp"
+
+#include "app/config.hpp"
+#include "core/errors.hpp"
+#include "io/result_diff.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <new>
+#include <string>
+
+namespace vproxq {
+namespace {
+
+const char* kDescription =
+    "vproxq: exact proximity queries on animated triangle meshes.\n"
+    "For every frame of SCENE (a scene.json or a single mesh file) and every object: the\n"
+    "nearest other object, the separation distance and the closest triangle pair.\n"
+    "Exit codes: 0 ok, 2 usage error, 3 input error, 4 runtime error.\n"
+    "See also: vproxq diff A.json B.json (compare two result files).";
+
+/// Parses "A:B", "A:", ":B" or "A" (a single frame) into a FrameRange.
+FrameRange parse_frame_range(const std::string& text) {
+  auto parse_part = [&](const std::string& s) -> long {
+    if (s.empty() || s.find_first_not_of("0123456789") != std::string::npos)
+      throw UsageError("--frames " + text + ": expected A:B with non-negative integers (B exclusive)");
+    return std::stol(s);
+  };
+  FrameRange r;
+  const auto colon = text.find(':');
+  if (colon == std::string::npos) {
+    r.first = parse_part(text);
+    r.last = *r.first + 1;
+    return r;
+  }
+  const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
+  if (!a.empty()) r.first = parse_part(a);
+  if (!b.empty()) r.last = parse_part(b);
+  if (r.first && r.last && *r.last <= *r.first)
+    throw UsageError("--frames " + text + ": the range is empty (B is exclusive and must exceed A)");
+  return r;
+}
+
+int report(const char* kind, const std::exception& e, int code) {
+  std::fprintf(stderr, "vproxq: %s: %s\n", kind, e.what());
+  return code;
+}
+
+/// Runs `body`, mapping the error kinds to their exit codes.
+template <typename F>
+int guarded(F&& body) {
+  try {
+    return body();
+  } catch (const UsageError& e) {
+    return report("usage error", e, exit_code::kUsage);
+  } catch (const InputError& e) {
+    return report("input error", e, exit_code::kInput);
+  } catch (const RuntimeError& e) {
+    return report("error", e, exit_code::kRuntime);
+  } catch (const std::bad_alloc& e) {
+    return report("error", e, exit_code::kRuntime);
+  } catch (const std::exception& e) {
+    return report("error", e, exit_code::kRuntime);
+  }
+}
+
+int parse_or_exit(CLI::App& app, int argc, char** argv, bool& done) {
+  done = false;
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    done = true;
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    done = true;
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    done = true;
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    done = true;
+    std::fprintf(stderr, "vproxq: usage error: %s\nRun with --help for the options.\n", e.what());
+    return exit_code::kUsage;
+  }
+  return 0;
+}
+
+int diff_main(int argc, char** argv) {
+  CLI::App app{"vproxq diff: compare two results.json files, ignoring \"stats\", \"version\" and "
+               "\"settings\".\nExit codes: 0 equal (within tolerance), 1 different, 2 usage "
+               "error, 3 input error.", "vproxq diff"};
+  std::string a, b;
+  DiffOptions opts;
+  app.add_option("A", a, "first results.json")->required();
+  app.add_option("B", b, "second results.json")->required();
+  app.add_option("--rtol", opts.rtol, "relative tolerance for numbers (default 0)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--atol", opts.atol, "absolute tolerance for numbers (default 0)")
+      ->check(CLI::NonNegativeNumber);
+  bool done = false;
+  const int code = parse_or_exit(app, argc, argv, done);
+  if (done) return code;
+  return guarded([&] {
+    const DiffOutcome out = diff_result_files(a, b, opts);
+    if (out.equal) {
+      std::printf("identical (ignoring stats, version, settings)\n");
+      return exit_code::kOk;
+    }
+    std::printf("different: %s\n", out.first_difference.c_str());
+    return exit_code::kDifferent;
+  });
+}
+
+}  // namespace
+
+int cli_main(int argc, char** argv) {
+  if (argc >= 2 && std::strcmp(argv[1], "diff") == 0) return diff_main(argc - 1, argv + 1);
+
+  CLI::App app{kDescription, "vproxq"};
+  Config config;
+  std::string frames;
+  app.add_option("SCENE", config.scene_path, "scene.json, or a mesh file (a one-frame scene)")
+      ->required();
+  app.add_option("--queries", config.queries,
+                 "comma-separated queries to run (default: the scene's \"queries\", else "
+                 "distance). Valid: distance")
+      ->delimiter(',');
+  app.add_option("-o,--output", config.output_dir,
+                 "write OUT/results.json and OUT/results.h5 (default: print a summary)");
+  app.add_option("--frames", frames, "frame range A:B (0-based, B exclusive; A: or :B or A)");
+  app.add_option("--voronoi", config.voronoi,
+                 "Stage II backend. Valid: off (AABB culling, then exact tests)");
+  app.add_option("--threads", config.threads, "worker threads (default 0: all cores)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag("-q,--quiet", config.quiet, "no progress or summary on the terminal");
+  app.set_version_flag("--version", std::string("vproxq ") + VPROXQ_VERSION);
+  bool done = false;
+  const int code = parse_or_exit(app, argc, argv, done);
+  if (done) return code;
+  return guarded([&] {
+    if (!frames.empty()) config.frames = parse_frame_range(frames);
+    run(config);
+    return exit_code::kOk;
+  });
+}
+
+}  // namespace vproxq

@@ -1,0 +1,28 @@
+#pragma once
+// Everything a run needs, filled by the CLI (app/cli.cpp) and consumed by run().
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace vproxq {
+
+struct FrameRange {
+  std::optional<long> first;  ///< inclusive, 0-based position; default 0
+  std::optional<long> last;   ///< exclusive; default: end of sequence
+};
+
+struct Config {
+  std::string scene_path;
+  std::vector<std::string> queries;  ///< empty: scene.json's list, else {"distance"}
+  std::string output_dir;            ///< empty: no files written
+  FrameRange frames;
+  std::string voronoi = "off";
+  int threads = 0;  ///< 0: all hardware threads
+  bool quiet = false;
+};
+
+/// Runs the queries of `config` frame by frame and writes the outputs. Throws UsageError,
+/// InputError or RuntimeError (core/errors.hpp); never leaves partial output files.
+void run(const Config& config);
+
+}  // namespace vproxq

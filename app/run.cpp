@@ -1,0 +1,144 @@
+#include "app/config.hpp"
+#include "app/progress.hpp"
+#include "core/errors.hpp"
+#include "core/parallel.hpp"
+#include "core/query/inter_distance.hpp"
+#include "core/timer.hpp"
+#include "io/output.hpp"
+#include "io/scene_source.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+namespace vproxq {
+namespace {
+
+/// Queries in canonical order with their state in this version.
+struct QueryName {
+  const char* name;
+  bool implemented;
+};
+constexpr QueryName kQueries[] = {{"distance", true}, {"ccd", false}, {"pd", false}};
+
+std::string valid_queries() {
+  std::string s;
+  for (const auto& q : kQueries)
+    if (q.implemented) s += (s.empty() ? "" : ", ") + std::string(q.name);
+  return s;
+}
+
+/// Checks the requested queries and returns them in canonical order, without duplicates.
+std::vector<std::string> canonical_queries(const std::vector<std::string>& requested,
+                                           const char* origin) {
+  for (const auto& r : requested) {
+    const auto* q = std::find_if(std::begin(kQueries), std::end(kQueries),
+                                 [&](const QueryName& k) { return r == k.name; });
+    if (q == std::end(kQueries))
+      throw UsageError(std::string(origin) + ": unknown query '" + r +
+                       "'; valid queries: " + valid_queries());
+    if (!q->implemented)
+      throw UsageError(std::string(origin) + ": query '" + r +
+                       "' is not implemented in this version; valid queries: " + valid_queries());
+  }
+  std::vector<std::string> out;
+  for (const auto& q : kQueries)
+    if (std::find(requested.begin(), requested.end(), q.name) != requested.end())
+      out.emplace_back(q.name);
+  if (out.empty()) throw UsageError(std::string(origin) + ": no query given; valid queries: " + valid_queries());
+  return out;
+}
+
+void print_summary(const FrameResult& r) {
+  std::size_t tris = 0;
+  for (const auto& o : r.objects) tris += static_cast<std::size_t>(o.triangles);
+  std::printf("frame %d: %zu objects, %zu triangles, %.1f ms\n", r.frame, r.objects.size(), tris,
+              r.time_ms.total);
+  if (!r.inter) return;
+  for (const auto& d : *r.inter) {
+    const auto& name = r.objects[static_cast<std::size_t>(d.object)].name;
+    if (!d.has_nearest()) {
+      std::printf("  %4d %-16s no other object\n", d.object, name.c_str());
+      continue;
+    }
+    std::printf("  %4d %-16s nearest %4d %-16s distance %.17g  triangles %d,%d\n", d.object,
+                name.c_str(), d.nearest_object,
+                r.objects[static_cast<std::size_t>(d.nearest_object)].name.c_str(), d.distance,
+                d.triangles[0], d.triangles[1]);
+  }
+}
+
+}  // namespace
+
+void run(const Config& config) {
+  if (config.voronoi != "off")
+    throw UsageError("--voronoi " + config.voronoi +
+                     ": the Voronoi stage is not available in this version; valid values: off");
+  const SceneSource scene = SceneSource::open(config.scene_path);
+
+  std::vector<std::string> queries =
+      !config.queries.empty() ? canonical_queries(config.queries, "--queries")
+      : !scene.queries().empty()
+          ? canonical_queries(scene.queries(), (config.scene_path + ": \"queries\"").c_str())
+          : std::vector<std::string>{"distance"};
+
+  const long count = static_cast<long>(scene.frame_count());
+  const long first = config.frames.first.value_or(0);
+  const long last = std::min(config.frames.last.value_or(count), count);
+  if (first >= count)
+    throw UsageError("--frames: first frame " + std::to_string(first) + " is past the end (" +
+                     config.scene_path + " has " + std::to_string(count) + " frames)");
+
+  RunInfo info;
+  info.scene = config.scene_path;
+  info.scene_name = scene.name();
+  info.queries = queries;
+  info.voronoi = config.voronoi;
+  info.threads = resolve_threads(config.threads);
+  info.frame_count = static_cast<std::size_t>(last - first);
+
+  std::unique_ptr<ResultWriter> writer;
+  if (!config.output_dir.empty()) writer = std::make_unique<ResultWriter>(config.output_dir, info);
+
+  const bool want_distance = std::find(queries.begin(), queries.end(), "distance") != queries.end();
+  Progress progress(info.frame_count, !config.quiet);
+  for (long k = first; k < last; ++k) {
+    Stopwatch total;
+    FrameResult result;
+    result.frame = static_cast<int>(k);
+    Stopwatch sw;
+    const Frame frame = scene.load_frame(static_cast<std::size_t>(k));
+    result.time_ms.load = sw.elapsed_ms();
+    result.files = frame.files;
+    for (std::size_t i = 0; i < frame.objects.size(); ++i) {
+      const Object& o = frame.objects[i];
+      result.objects.push_back({static_cast<Index>(i), o.name, o.num_vertices(), o.num_triangles(), o.is_static});
+    }
+    if (want_distance) {
+      InterDistanceOutput d = inter_object_distance(frame, {info.threads});
+      result.time_ms.aabb = d.aabb_ms;
+      result.time_ms.exact = d.exact_ms;
+      result.counters = d.counters;
+      result.inter = std::move(d.per_object);
+    }
+    result.time_ms.total = total.elapsed_ms();
+    if (writer) {
+      // write_frame() fills in and adds its own time before serialising the stats.
+      writer->write_frame(result);
+    } else if (!config.quiet) {
+      progress.finish();
+      print_summary(result);
+    }
+    progress.update(static_cast<std::size_t>(k - first + 1));
+  }
+  progress.finish();
+  if (writer) {
+    writer->commit();
+    if (!config.quiet)
+      std::fprintf(stderr, "vproxq: wrote %s/results.json and %s/results.h5 (%zu frames)\n",
+                   config.output_dir.c_str(), config.output_dir.c_str(), info.frame_count);
+  }
+}
+
+}  // namespace vproxq

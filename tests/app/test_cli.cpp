@@ -1,0 +1,308 @@
+// End-to-end tests of the CLI: bad input gets its message and exit code; results equal brute
+// force; runs are reproducible and `vproxq diff` says so.
+#include "core/query/inter_distance.hpp"
+#include "io/scene_source.hpp"
+#include "support/process.hpp"
+#include "support/random_scene.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+
+namespace vproxq {
+namespace {
+
+namespace fs = std::filesystem;
+using test::quote;
+using test::run_command;
+using test::ScratchDir;
+
+const std::string kVproxq = VPROXQ_BINARY;
+const fs::path kSamples = VPROXQ_SAMPLE_SCENES_DIR;
+
+test::ProcessResult vproxq(const std::string& args) { return run_command(kVproxq + " " + args); }
+
+/// Writes a frame as one OBJ with an `o` group per object, 17 significant digits.
+void write_obj(const Frame& frame, const fs::path& file) {
+  std::ofstream out(file);
+  out.precision(17);
+  Index base = 1;
+  for (const Object& o : frame.objects) {
+    out << "o " << o.name << "\n";
+    for (const Vec3& p : o.positions) out << "v " << p.x() << " " << p.y() << " " << p.z() << "\n";
+    for (const Face& f : o.topology->faces)
+      out << "f " << f[0] + base << " " << f[1] + base << " " << f[2] + base << "\n";
+    base += o.num_vertices();
+  }
+}
+
+nlohmann::json read_json(const fs::path& p) {
+  std::ifstream in(p);
+  return nlohmann::json::parse(in);
+}
+
+/// Every frame of results.json equals the brute force on the frames the scene loads.
+void expect_results_equal_brute_force(const fs::path& scene_path, const fs::path& results) {
+  const SceneSource scene = SceneSource::open(scene_path);
+  const nlohmann::json j = read_json(results);
+  ASSERT_EQ(j.at("frames").size(), scene.frame_count());
+  for (size_t k = 0; k < scene.frame_count(); ++k) {
+    const Frame frame = scene.load_frame(k);
+    const auto ref = inter_object_distance_brute_force(frame);
+    const auto& inter = j["frames"][k]["distance"]["inter"];
+    ASSERT_EQ(inter.size(), ref.per_object.size());
+    for (size_t i = 0; i < ref.per_object.size(); ++i) {
+      const auto& r = ref.per_object[i];
+      SCOPED_TRACE("frame " + std::to_string(k) + " object " + std::to_string(i));
+      EXPECT_EQ(inter[i]["object"].get<int>(), static_cast<int>(i));
+      if (!r.has_nearest()) {
+        EXPECT_TRUE(inter[i]["nearest_object"].is_null());
+        continue;
+      }
+      EXPECT_EQ(inter[i]["nearest_object"].get<int>(), r.nearest_object);
+      EXPECT_EQ(inter[i]["distance"].get<double>(), r.distance);  // JSON round-trips doubles
+      EXPECT_EQ(inter[i]["triangles"][0].get<int>(), r.triangles[0]);
+      EXPECT_EQ(inter[i]["triangles"][1].get<int>(), r.triangles[1]);
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(inter[i]["points"][0][c].get<double>(), r.points[0][c]);
+        EXPECT_EQ(inter[i]["points"][1][c].get<double>(), r.points[1][c]);
+      }
+    }
+  }
+}
+
+TEST(Cli, HelpAndVersion) {
+  auto r = vproxq("--help");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("--queries"), std::string::npos);
+  EXPECT_NE(r.output.find("Exit codes"), std::string::npos);
+  r = vproxq("--version");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.output.find(VPROXQ_VERSION), std::string::npos);
+  r = vproxq("diff --help");
+  EXPECT_EQ(r.exit_code, 0);
+}
+
+TEST(Cli, UsageErrors) {
+  const std::string scene = quote(kSamples / "two-cubes" / "scene.json");
+  auto r = vproxq(scene + " --queries=distance,bogus");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("unknown query 'bogus'"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("valid queries: distance"), std::string::npos) << r.output;
+  r = vproxq(scene + " --queries=ccd");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("not implemented"), std::string::npos) << r.output;
+  r = vproxq(scene + " --voronoi=sometimes");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = vproxq(scene + " --threads=-3");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = vproxq(scene + " --frames=7:9");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("has 3 frames"), std::string::npos) << r.output;
+  r = vproxq(scene + " --frames=2:1");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = vproxq(scene + " --frames=x");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = vproxq("");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = vproxq(scene + " --no-such-option");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = vproxq("diff onlyone.json");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+}
+
+/// A scene directory with frames written from random blobs, for the input-error cases.
+struct BadInputCase {
+  std::string name;
+  std::string frame0, frame1;  // OBJ texts
+  std::string expect;          // substring of the message
+};
+
+TEST(Cli, InputErrorsNameTheFileAndLeaveNoOutput) {
+  const std::string good = "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no b\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf 4 5 6\n";
+  const std::vector<BadInputCase> cases = {
+      {"malformed", good, "o a\nv 0 0 zero\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "frame_1.obj"},
+      {"index_out_of_range", good, "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "out of range"},
+      {"nan", good, "o a\nv 0 0 nan\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "frame_1.obj"},
+      {"inf", good, "o a\nv 0 0 inf\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "frame_1.obj"},
+      {"empty_frame", good, "# nothing here\n", "frame_1.obj"},
+      {"object_count", good, "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "frame_1.obj"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    ScratchDir dir;
+    dir.write("frame_0.obj", c.frame0);
+    dir.write("frame_1.obj", c.frame1);
+    const auto scene = dir.write(
+        "scene.json", R"({"frames": {"pattern": "frame_%d.obj", "first": 0, "count": 2}})");
+    const auto out = dir / "out";
+    const auto r = vproxq(quote(scene) + " -o " + quote(out) + " --quiet");
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    EXPECT_NE(r.output.find(c.expect), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out / "results.json"));
+    EXPECT_FALSE(fs::exists(out / "results.h5"));
+    if (fs::exists(out)) EXPECT_TRUE(fs::is_empty(out)) << "temporary files left behind";
+  }
+}
+
+TEST(Cli, SceneFileErrors) {
+  ScratchDir dir;
+  auto r = vproxq(quote(dir / "missing.json"));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("missing.json"), std::string::npos) << r.output;
+
+  dir.write("a.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {R"({"frames": {"files": ["a.obj"]}, "objcts": "meshes"})", "objcts"},
+      {R"({"frames": {"pattern": "a_%d.obj", "first": 0, "count": -3}})", "count"},
+      {R"({"frames": {"files": ["nope.obj"]}})", "nope.obj"},
+      {R"({"frames": {"files": ["a.obj"]}, "objects": "pieces"})", "objects"},
+      {R"({"frames": {"files": ["a.obj"]}, "grid": "big"})", "grid"},
+      {R"({"frames": )", "scene.json"},
+      {R"({"name": "no frames"})", "frames"},
+  };
+  for (const auto& [text, key] : bad) {
+    SCOPED_TRACE(text);
+    const auto scene = dir.write("scene.json", text);
+    r = vproxq(quote(scene) + " --quiet");
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    EXPECT_NE(r.output.find(key), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("scene.json"), std::string::npos) << r.output;
+  }
+}
+
+TEST(Cli, UnwritableOutputIsARuntimeError) {
+  ScratchDir dir;
+  const auto blocker = dir.write("file", "not a directory\n");
+  const auto r = vproxq(quote(kSamples / "two-cubes" / "scene.json") + " -o " + quote(blocker / "out") + " --quiet");
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  EXPECT_NE(r.output.find("out"), std::string::npos) << r.output;
+}
+
+TEST(Cli, FailureKeepsEarlierResultsIntact) {
+  ScratchDir dir;
+  const std::string tri = "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no b\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf 4 5 6\n";
+  dir.write("f_0.obj", tri);
+  dir.write("f_1.obj", tri);
+  const auto scene = dir.write("scene.json", R"({"frames": {"pattern": "f_%d.obj", "first": 0, "count": 2}})");
+  const auto out = dir / "out";
+  auto r = vproxq(quote(scene) + " -o " + quote(out) + " --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string before = [&] { std::ifstream in(out / "results.json"); return std::string(std::istreambuf_iterator<char>(in), {}); }();
+  dir.write("f_1.obj", "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+  r = vproxq(quote(scene) + " -o " + quote(out) + " --quiet");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  const std::string after = [&] { std::ifstream in(out / "results.json"); return std::string(std::istreambuf_iterator<char>(in), {}); }();
+  EXPECT_EQ(before, after);
+  EXPECT_TRUE(fs::exists(out / "results.h5"));
+}
+
+TEST(Cli, SampleScenesEqualBruteForce) {
+  for (const char* name : {"two-cubes", "blobs-small"}) {
+    SCOPED_TRACE(name);
+    ScratchDir dir;
+    const auto scene = kSamples / name / "scene.json";
+    const auto r = vproxq(quote(scene) + " -o " + quote(dir / "out") + " --quiet --threads 2");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    ASSERT_TRUE(fs::exists(dir / "out" / "results.h5"));
+    expect_results_equal_brute_force(scene, dir / "out" / "results.json");
+  }
+}
+
+TEST(Cli, TwoCubesFarCloseIntersecting) {
+  ScratchDir dir;
+  const auto r = vproxq(quote(kSamples / "two-cubes" / "scene.json") + " -o " + quote(dir / "out") + " --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = read_json(dir / "out" / "results.json");
+  ASSERT_EQ(j["frames"].size(), 3u);
+  const double far = j["frames"][0]["distance"]["inter"][0]["distance"];
+  const double close = j["frames"][1]["distance"]["inter"][0]["distance"];
+  const double touching = j["frames"][2]["distance"]["inter"][0]["distance"];
+  EXPECT_GT(far, close);
+  EXPECT_GT(close, 0.0);
+  EXPECT_EQ(touching, 0.0);
+}
+
+TEST(Cli, RandomScenesEqualBruteForce) {
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    ScratchDir dir;
+    for (int k = 0; k < 3; ++k)
+      write_obj(test::make_random_frame(seed * 10 + static_cast<std::uint64_t>(k), 8, 2.5, 1),
+                dir / ("f_" + std::to_string(k) + ".obj"));
+    const auto scene = dir.write("scene.json", R"({"frames": {"pattern": "f_%d.obj", "first": 0, "count": 3}})");
+    const auto r = vproxq(quote(scene) + " -o " + quote(dir / "out") + " --quiet --threads 2");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    expect_results_equal_brute_force(scene, dir / "out" / "results.json");
+  }
+}
+
+TEST(Cli, RepeatedRunsAreIdenticalAndDiffDetectsChanges) {
+  ScratchDir dir;
+  const auto scene = quote(kSamples / "blobs-small" / "scene.json");
+  auto r = vproxq(scene + " -o " + quote(dir / "a") + " --quiet --threads 1");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = vproxq(scene + " -o " + quote(dir / "b") + " --quiet --threads 2");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto a = dir / "a" / "results.json", b = dir / "b" / "results.json";
+  r = vproxq("diff " + quote(a) + " " + quote(b));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+
+  // Perturb one distance: diff must fail and name the field; a tolerance accepts it.
+  nlohmann::json j = read_json(b);
+  const double d = j["frames"][2]["distance"]["inter"][1]["distance"];
+  j["frames"][2]["distance"]["inter"][1]["distance"] = d * (1 + 1e-9);
+  std::ofstream(dir / "c.json") << j.dump();
+  r = vproxq("diff " + quote(a) + " " + quote(dir / "c.json"));
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("frame 2"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("distance"), std::string::npos) << r.output;
+  r = vproxq("diff " + quote(a) + " " + quote(dir / "c.json") + " --rtol 1e-6");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  r = vproxq("diff " + quote(a) + " " + quote(dir / "missing.json"));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+}
+
+TEST(Cli, FrameRangeAndSummary) {
+  const auto scene = quote(kSamples / "two-cubes" / "scene.json");
+  auto r = vproxq(scene + " --frames 1:3");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("frame 0:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("frame 1:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("frame 2:"), std::string::npos) << r.output;
+  ScratchDir dir;
+  r = vproxq(scene + " --frames 2 -o " + quote(dir / "out") + " --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = read_json(dir / "out" / "results.json");
+  ASSERT_EQ(j["frames"].size(), 1u);
+  EXPECT_EQ(j["frames"][0]["frame"].get<int>(), 2);
+}
+
+}  // namespace
+}  // namespace vproxq
+
+namespace vproxq {
+namespace {
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+TEST(Generator, RegeneratesTheCommittedSampleSceneByteForByte) {
+  ScratchDir dir;
+  const auto r = run_command(std::string(VPROXQ_GEN_BINARY) +
+                             " blobs --objects 12 --subdiv 1 --frames 6 --seed 1 --out " + quote(dir.path()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto committed = kSamples / "blobs-small";
+  EXPECT_EQ(slurp(dir / "scene.json"), slurp(committed / "scene.json"));
+  for (int k = 0; k < 6; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frames/blobs_%04d.obj", k);
+    EXPECT_EQ(slurp(dir / name), slurp(committed / name)) << name;
+  }
+}
+
+}  // namespace
+}  // namespace vproxq
