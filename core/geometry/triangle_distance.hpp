@@ -1,0 +1,46 @@
+#pragma once
+// Exact-as-double triangle–triangle distance with closest points and the winning feature case.
+#include "core/types.hpp"
+
+namespace vproxq {
+
+/// Which feature pair realises the distance between triangles A and B.
+enum class TriangleDistanceCase : std::uint8_t {
+  Intersecting,  ///< the closed triangles share a point; distance is exactly 0
+  VertexFace,    ///< a vertex of A (feature_a) against the closed triangle B
+  FaceVertex,    ///< the closed triangle A against a vertex of B (feature_b)
+  EdgeEdge,      ///< edge feature_a of A against edge feature_b of B
+};
+
+/// Result of triangle_distance(). Edge k of a triangle joins corner k and corner (k+1)%3.
+struct TriangleDistanceResult {
+  double distance = kInfinity;
+  Vec3 point_a = Vec3::Zero();  ///< closest point on A
+  Vec3 point_b = Vec3::Zero();  ///< closest point on B (== point_a when intersecting)
+  TriangleDistanceCase kind = TriangleDistanceCase::Intersecting;
+  std::int8_t feature_a = -1;  ///< corner (VertexFace) or edge (EdgeEdge) of A, else -1
+  std::int8_t feature_b = -1;  ///< corner (FaceVertex) or edge (EdgeEdge) of B, else -1
+};
+
+/// Distance between the closed triangles a and b (any shape, degenerate ones included).
+/// Intersection is decided with exact orientation predicates, so touching or crossing
+/// triangles give exactly 0. Otherwise the distance is the minimum over the 6 vertex–face and
+/// 9 edge–edge feature pairs, ties going to the first in that order.
+///
+/// Details (core/geometry/triangle_distance.cpp): the order is VF a0, a1, a2, FV b0, b1, b2,
+/// then EE (feature_a, feature_b) row-major; squared distances are compared and the square root
+/// taken once; each candidate's value is bitwise that of point_triangle_distance() or
+/// segment_segment_distance(), and the reported points are theirs. Distances are accurate to a
+/// few ulps of the largest coordinate (they are computed from coordinate differences); points
+/// are rounded to their coordinates' grid. For intersecting triangles point_a == point_b is one
+/// common point, computed approximately (within a few ulps of both triangles). Deterministic:
+/// equal inputs give bitwise equal results. Inputs must be finite; exactness of the intersection
+/// decision holds for coordinates of magnitude in [2^-200, 2^200] or zero (predicates.hpp).
+TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b);
+
+/// True when the closed triangles a and b share at least one point (exact predicates). A
+/// degenerate triangle is the union of its edges. Defined in triangle_intersection.cpp, which
+/// also offers the common point (triangle_intersection()).
+bool triangles_intersect(const Triangle& a, const Triangle& b);
+
+}  // namespace vproxq

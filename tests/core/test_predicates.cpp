@@ -1,0 +1,440 @@
+// Tests of the exact orientation predicates against an independent exact twin: every double is
+// an integer times a power of two, so after scaling all inputs by a common power of two the
+// determinants are integer polynomials, evaluated here with a small arbitrary-precision integer.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+#include "core/geometry/predicates.hpp"
+
+namespace vproxq {
+namespace {
+
+// ---- the twin: sign-magnitude big integers ------------------------------------------------
+
+/// Arbitrary-precision integer: just enough (add, subtract, multiply, shift) for determinants.
+struct BigInt {
+  bool negative = false;
+  std::vector<std::uint32_t> mag;  // little-endian base 2^32, no leading zero limbs; {} == 0
+
+  static BigInt from_int64(std::int64_t v) {
+    BigInt r;
+    r.negative = v < 0;
+    std::uint64_t m = v < 0 ? static_cast<std::uint64_t>(-(v + 1)) + 1 : static_cast<std::uint64_t>(v);
+    while (m != 0) {
+      r.mag.push_back(static_cast<std::uint32_t>(m & 0xffffffffu));
+      m >>= 32;
+    }
+    return r;
+  }
+  int sign() const { return mag.empty() ? 0 : (negative ? -1 : 1); }
+  void trim() {
+    while (!mag.empty() && mag.back() == 0) mag.pop_back();
+    if (mag.empty()) negative = false;
+  }
+  BigInt shifted_left(int bits) const {
+    BigInt r;
+    r.negative = negative;
+    r.mag.assign(static_cast<std::size_t>(bits / 32), 0u);
+    const int s = bits % 32;
+    std::uint32_t carry = 0;
+    for (std::uint32_t limb : mag) {
+      const std::uint64_t wide = (static_cast<std::uint64_t>(limb) << s) | carry;
+      r.mag.push_back(static_cast<std::uint32_t>(wide & 0xffffffffu));
+      carry = s == 0 ? 0 : static_cast<std::uint32_t>(limb >> (32 - s));
+    }
+    r.mag.push_back(carry);
+    r.trim();
+    return r;
+  }
+};
+
+int compare_magnitude(const BigInt& a, const BigInt& b) {
+  if (a.mag.size() != b.mag.size()) return a.mag.size() < b.mag.size() ? -1 : 1;
+  for (std::size_t i = a.mag.size(); i-- > 0;) {
+    if (a.mag[i] != b.mag[i]) return a.mag[i] < b.mag[i] ? -1 : 1;
+  }
+  return 0;
+}
+
+std::vector<std::uint32_t> add_magnitude(const BigInt& a, const BigInt& b) {
+  std::vector<std::uint32_t> r;
+  std::uint64_t carry = 0;
+  for (std::size_t i = 0; i < std::max(a.mag.size(), b.mag.size()); ++i) {
+    const std::uint64_t s = carry + (i < a.mag.size() ? a.mag[i] : 0u) + (i < b.mag.size() ? b.mag[i] : 0u);
+    r.push_back(static_cast<std::uint32_t>(s & 0xffffffffu));
+    carry = s >> 32;
+  }
+  r.push_back(static_cast<std::uint32_t>(carry));
+  return r;
+}
+
+/// |a| - |b| for |a| >= |b|.
+std::vector<std::uint32_t> subtract_magnitude(const BigInt& a, const BigInt& b) {
+  std::vector<std::uint32_t> r;
+  std::int64_t borrow = 0;
+  for (std::size_t i = 0; i < a.mag.size(); ++i) {
+    std::int64_t d = static_cast<std::int64_t>(a.mag[i]) - borrow - (i < b.mag.size() ? b.mag[i] : 0u);
+    borrow = d < 0 ? 1 : 0;
+    if (d < 0) d += std::int64_t{1} << 32;
+    r.push_back(static_cast<std::uint32_t>(d));
+  }
+  return r;
+}
+
+BigInt operator+(const BigInt& a, const BigInt& b) {
+  BigInt r;
+  if (a.negative == b.negative) {
+    r.mag = add_magnitude(a, b);
+    r.negative = a.negative;
+  } else if (compare_magnitude(a, b) >= 0) {
+    r.mag = subtract_magnitude(a, b);
+    r.negative = a.negative;
+  } else {
+    r.mag = subtract_magnitude(b, a);
+    r.negative = b.negative;
+  }
+  r.trim();
+  return r;
+}
+
+BigInt operator-(const BigInt& a) {
+  BigInt r = a;
+  r.negative = !a.negative;
+  r.trim();
+  return r;
+}
+
+BigInt operator-(const BigInt& a, const BigInt& b) { return a + (-b); }
+
+BigInt operator*(const BigInt& a, const BigInt& b) {
+  BigInt r;
+  r.mag.assign(a.mag.size() + b.mag.size() + 1, 0u);
+  for (std::size_t i = 0; i < a.mag.size(); ++i) {
+    std::uint64_t carry = 0;
+    for (std::size_t j = 0; j < b.mag.size(); ++j) {
+      const std::uint64_t cur = r.mag[i + j] + static_cast<std::uint64_t>(a.mag[i]) * b.mag[j] + carry;
+      r.mag[i + j] = static_cast<std::uint32_t>(cur & 0xffffffffu);
+      carry = cur >> 32;
+    }
+    std::size_t k = i + b.mag.size();
+    while (carry != 0) {
+      const std::uint64_t cur = r.mag[k] + carry;
+      r.mag[k] = static_cast<std::uint32_t>(cur & 0xffffffffu);
+      carry = cur >> 32;
+      ++k;
+    }
+  }
+  r.negative = a.negative != b.negative;
+  r.trim();
+  return r;
+}
+
+/// Converts doubles to integers by one common power-of-two scale (which keeps determinant
+/// signs: both predicates are homogeneous in a positive scale).
+class ExactScale {
+ public:
+  explicit ExactScale(const std::vector<double>& values) {
+    for (double v : values) {
+      if (v != 0.0) min_exponent_ = std::min(min_exponent_, exponent_of(v));
+    }
+  }
+  BigInt operator()(double v) const {
+    if (v == 0.0) return BigInt{};
+    int e = 0;
+    const double fraction = std::frexp(v, &e);  // v = fraction * 2^e, |fraction| in [0.5, 1)
+    const auto mantissa = static_cast<std::int64_t>(std::ldexp(fraction, 53));
+    return BigInt::from_int64(mantissa).shifted_left(e - 53 - min_exponent_);
+  }
+
+ private:
+  static int exponent_of(double v) {
+    int e = 0;
+    std::frexp(v, &e);
+    return e - 53;
+  }
+  int min_exponent_ = 1 << 20;
+};
+
+int exact_orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const ExactScale big({a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], d[0], d[1], d[2]});
+  BigInt u[3], v[3], w[3];
+  for (int k = 0; k < 3; ++k) {
+    u[k] = big(b[k]) - big(a[k]);
+    v[k] = big(c[k]) - big(a[k]);
+    w[k] = big(d[k]) - big(a[k]);
+  }
+  const BigInt det = u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2]) +
+                     u[2] * (v[0] * w[1] - v[1] * w[0]);
+  return det.sign();
+}
+
+int exact_orient2d(const Vec2& a, const Vec2& b, const Vec2& c) {
+  const ExactScale big({a[0], a[1], b[0], b[1], c[0], c[1]});
+  const BigInt det = (big(b[0]) - big(a[0])) * (big(c[1]) - big(a[1])) -
+                     (big(b[1]) - big(a[1])) * (big(c[0]) - big(a[0]));
+  return det.sign();
+}
+
+/// Plain double evaluation, to show the adversarial inputs really defeat it.
+int naive_orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const double det = (b - a).cross(c - a).dot(d - a);
+  return (det > 0) - (det < 0);
+}
+int naive_orient2d(const Vec2& a, const Vec2& b, const Vec2& c) {
+  const double det = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+  return (det > 0) - (det < 0);
+}
+
+__extension__ typedef __int128 Int128;  // GCC/Clang extension, test-only
+
+int sign_of_int128(Int128 v) { return (v > 0) - (v < 0); }
+
+Int128 int_orient3d(const std::array<std::int64_t, 12>& p) {
+  const Int128 ux = p[3] - p[0], uy = p[4] - p[1], uz = p[5] - p[2];
+  const Int128 vx = p[6] - p[0], vy = p[7] - p[1], vz = p[8] - p[2];
+  const Int128 wx = p[9] - p[0], wy = p[10] - p[1], wz = p[11] - p[2];
+  return ux * (vy * wz - vz * wy) + uy * (vz * wx - vx * wz) + uz * (vx * wy - vy * wx);
+}
+
+Vec3 random_point(std::mt19937_64& rng, double half_size, double offset = 0.0) {
+  std::uniform_real_distribution<double> u(-half_size, half_size);
+  return Vec3(offset + u(rng), offset + u(rng), offset + u(rng));
+}
+
+/// x moved by `steps` ulps (toward +inf when positive).
+double ulp_step(double x, int steps) {
+  for (int i = 0; i < std::abs(steps); ++i) {
+    x = std::nextafter(x, steps > 0 ? kInfinity : -kInfinity);
+  }
+  return x;
+}
+
+// ---- tests ----------------------------------------------------------------------------------
+
+TEST(BigIntTwin, AgreesWithInt128OnSmallIntegers) {
+  std::mt19937_64 rng(1);
+  std::uniform_int_distribution<std::int64_t> coord(-(std::int64_t{1} << 40), std::int64_t{1} << 40);
+  for (int trial = 0; trial < 2000; ++trial) {
+    std::array<std::int64_t, 12> p{};
+    for (auto& x : p) x = coord(rng);
+    // |differences| < 2^41 and |det| < 6 * 2^123: int128 holds it.
+    const Vec3 a(p[0], p[1], p[2]), b(p[3], p[4], p[5]), c(p[6], p[7], p[8]), d(p[9], p[10], p[11]);
+    ASSERT_EQ(exact_orient3d(a, b, c, d), sign_of_int128(int_orient3d(p)));
+  }
+  const BigInt big = BigInt::from_int64(-123456789012345) * BigInt::from_int64(987654321);
+  EXPECT_EQ(big.sign(), -1);
+  EXPECT_EQ((big - big).sign(), 0);
+}
+
+TEST(Orient, SignConventions) {
+  const Vec3 o(0, 0, 0), ex(1, 0, 0), ey(0, 1, 0), ez(0, 0, 1);
+  EXPECT_EQ(orient3d(o, ex, ey, ez), 1);   // d on the side of (b-a)x(c-a)
+  EXPECT_EQ(orient3d(o, ey, ex, ez), -1);
+  EXPECT_EQ(orient3d(o, ex, ey, Vec3(0.3, 0.7, 0)), 0);
+  EXPECT_EQ(orient2d(Vec2(0, 0), Vec2(1, 0), Vec2(0, 1)), 1);  // counterclockwise
+  EXPECT_EQ(orient2d(Vec2(0, 0), Vec2(0, 1), Vec2(1, 0)), -1);
+  EXPECT_EQ(orient2d(Vec2(0, 0), Vec2(1, 1), Vec2(3, 3)), 0);
+  // Degenerate inputs: repeated points.
+  EXPECT_EQ(orient3d(o, o, ey, ez), 0);
+  EXPECT_EQ(orient3d(ex, ex, ex, ex), 0);
+  EXPECT_EQ(orient2d(Vec2(1, 2), Vec2(1, 2), Vec2(5, 7)), 0);
+  // orient2d_projected(axis) is the sign of component `axis` of (b-a) x (c-a).
+  EXPECT_EQ(orient2d_projected(o, ex, ey, 2), 1);
+  EXPECT_EQ(orient2d_projected(o, ey, ez, 0), 1);
+  EXPECT_EQ(orient2d_projected(o, ez, ex, 1), 1);
+}
+
+TEST(Orient3d, SmallIntegerInputsAreExact) {
+  // Coordinates in [-3, 3]: a large share of the cases is exactly coplanar.
+  std::mt19937_64 rng(2);
+  std::uniform_int_distribution<int> coord(-3, 3);
+  int zeros = 0;
+  for (int trial = 0; trial < 100000; ++trial) {
+    std::array<std::int64_t, 12> p{};
+    for (auto& x : p) x = coord(rng);
+    const Vec3 a(p[0], p[1], p[2]), b(p[3], p[4], p[5]), c(p[6], p[7], p[8]), d(p[9], p[10], p[11]);
+    const int expected = sign_of_int128(int_orient3d(p));
+    ASSERT_EQ(orient3d(a, b, c, d), expected) << "trial " << trial;
+    zeros += expected == 0;
+  }
+  EXPECT_GT(zeros, 1000);
+}
+
+TEST(Orient3d, OneUlpAroundAPlaneMatchesTwin) {
+  // d is put on the plane (a, b, c) in double arithmetic, then moved by -3..3 ulps per
+  // coordinate: the determinant is then tiny and plain double evaluation often gets its sign
+  // wrong. Offsets up to 1e6 and mixed magnitudes are covered.
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::uniform_int_distribution<int> step(-3, 3);
+  const double offsets[] = {0.0, 1.0, 1e6, -3.7e4};
+  const PredicateCounters before = predicate_counters();
+  int naive_wrong = 0;
+  int cases = 0;
+  for (double offset : offsets) {
+    for (int trial = 0; trial < 5000; ++trial) {
+      const double size = std::ldexp(1.0, static_cast<int>(unit(rng) * 20) - 10);
+      const Vec3 a = random_point(rng, size, offset);
+      const Vec3 b = random_point(rng, size, offset);
+      const Vec3 c = random_point(rng, size, offset);
+      const double alpha = unit(rng) * 2 - 0.5;
+      const double beta = unit(rng) * 2 - 0.5;
+      Vec3 d = a + alpha * (b - a) + beta * (c - a);
+      for (int k = 0; k < 3; ++k) d[k] = ulp_step(d[k], step(rng));
+      const int expected = exact_orient3d(a, b, c, d);
+      ASSERT_EQ(orient3d(a, b, c, d), expected) << "offset " << offset << " trial " << trial;
+      // Permuting the arguments permutes the determinant's rows: exact signs must follow.
+      ASSERT_EQ(orient3d(b, a, c, d), -expected);
+      ASSERT_EQ(orient3d(b, c, a, d), expected);
+      ASSERT_EQ(orient3d(a, b, d, c), -expected);
+      ASSERT_EQ(orient3d(d, b, c, a), -expected);
+      naive_wrong += naive_orient3d(a, b, c, d) != expected;
+      ++cases;
+    }
+  }
+  // The inputs are adversarial: plain double evaluation fails on a good share of them...
+  const std::uint64_t fallbacks = predicate_counters().orient3d_exact - before.orient3d_exact;
+  std::printf("[ info ] %d cases: plain double wrong on %d, exact fallback ran %llu times\n",
+              cases, naive_wrong, static_cast<unsigned long long>(fallbacks));
+  EXPECT_GT(naive_wrong, cases / 50) << naive_wrong << " of " << cases;
+  // ...and the exact fallback did run.
+  EXPECT_GT(fallbacks, static_cast<std::uint64_t>(cases));
+}
+
+TEST(Orient3d, ConstructedCoplanarPointsGiveZeroAndOneUlpOffGivesTheSide) {
+  // a, b, c on a 2^-10 grid around an offset, d = a + alpha (b-a) + beta (c-a) with alpha,
+  // beta multiples of 1/16: every value fits in 53 bits, so d is exactly on the plane.
+  std::mt19937_64 rng(4);
+  std::uniform_int_distribution<int> grid(-4096, 4096);
+  std::uniform_int_distribution<int> frac(-32, 48);
+  for (double offset : {0.0, 1e6, -2.5e5}) {
+    for (int trial = 0; trial < 3000; ++trial) {
+      auto grid_point = [&]() {
+        return Vec3(offset + std::ldexp(grid(rng), -10), offset + std::ldexp(grid(rng), -10),
+                    offset + std::ldexp(grid(rng), -10));
+      };
+      const Vec3 a = grid_point(), b = grid_point(), c = grid_point();
+      const double alpha = frac(rng) / 16.0;
+      const double beta = frac(rng) / 16.0;
+      const Vec3 d = a + alpha * (b - a) + beta * (c - a);
+      ASSERT_EQ(exact_orient3d(a, b, c, d), 0);  // the construction is exact
+      ASSERT_EQ(orient3d(a, b, c, d), 0);
+      ASSERT_EQ(orient3d(d, c, a, b), 0);
+      for (int k = 0; k < 3; ++k) {
+        Vec3 moved = d;
+        moved[k] = ulp_step(d[k], 1);
+        ASSERT_EQ(orient3d(a, b, c, moved), exact_orient3d(a, b, c, moved));
+        moved[k] = ulp_step(d[k], -1);
+        ASSERT_EQ(orient3d(a, b, c, moved), exact_orient3d(a, b, c, moved));
+      }
+    }
+  }
+}
+
+TEST(Orient3d, ExtremeMagnitudesWithinRange) {
+  // Scaling by a power of two keeps the sign; exactness must hold near both ends of the
+  // documented range and with mixed magnitudes inside one query.
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<int> step(-2, 2);
+  for (int scale_exp : {-190, -100, -30, 0, 30, 100, 190}) {
+    const double s = std::ldexp(1.0, scale_exp);
+    for (int trial = 0; trial < 500; ++trial) {
+      const Vec3 a = random_point(rng, 1.0), b = random_point(rng, 1.0), c = random_point(rng, 1.0);
+      Vec3 d = 0.25 * a + 0.5 * b + 0.25 * c;
+      d[trial % 3] = ulp_step(d[trial % 3], step(rng));
+      const int expected = exact_orient3d(a, b, c, d);
+      ASSERT_EQ(orient3d(s * a, s * b, s * c, s * d), expected) << scale_exp;
+      ASSERT_EQ(exact_orient3d(s * a, s * b, s * c, s * d), expected);
+    }
+  }
+  // Mixed: a tiny triangle far from a huge point, and points differing in the last bit.
+  const Vec3 a(1e-30, 0, 0), b(0, 1e-30, 0), c(0, 0, 1e-30);
+  EXPECT_EQ(orient3d(a, b, c, Vec3(1e30, 1e30, 1e30)), exact_orient3d(a, b, c, Vec3(1e30, 1e30, 1e30)));
+  const Vec3 p(1.0, 1.0, 1.0);
+  const Vec3 q(std::nextafter(1.0, 2.0), 1.0, 1.0);
+  const Vec3 r(1.0, std::nextafter(1.0, 2.0), 1.0);
+  EXPECT_EQ(orient3d(p, q, r, Vec3(1.0, 1.0, std::nextafter(1.0, 2.0))), 1);
+  EXPECT_EQ(orient3d(p, q, r, Vec3(1.0, 1.0, std::nextafter(1.0, 0.0))), -1);
+}
+
+TEST(Orient3d, FilterDecidesGenericInputs) {
+  // Random points in general position must not need the exact fallback (the filter is what
+  // makes the predicate cheap).
+  std::mt19937_64 rng(6);
+  const PredicateCounters before = predicate_counters();
+  for (int trial = 0; trial < 10000; ++trial) {
+    const Vec3 a = random_point(rng, 1.0), b = random_point(rng, 1.0), c = random_point(rng, 1.0),
+               d = random_point(rng, 1.0);
+    ASSERT_EQ(orient3d(a, b, c, d), naive_orient3d(a, b, c, d));
+  }
+  EXPECT_LE(predicate_counters().orient3d_exact - before.orient3d_exact, 5u);
+}
+
+TEST(Orient2d, ClassroomNearCollinearGrid) {
+  // Kettner et al., "Classroom examples of robustness problems in geometric computations":
+  // p = (0.5 + i u, 0.5 + j u), u = 2^-53, against the line through (12, 12) and (24, 24).
+  const Vec2 q(12, 12), r(24, 24);
+  int naive_wrong = 0;
+  for (int i = 0; i < 256; ++i) {
+    for (int j = 0; j < 256; ++j) {
+      const Vec2 p(0.5 + std::ldexp(i, -53), 0.5 + std::ldexp(j, -53));
+      const int expected = exact_orient2d(p, q, r);
+      ASSERT_EQ(orient2d(p, q, r), expected) << i << " " << j;
+      ASSERT_EQ(orient2d(q, r, p), expected);
+      ASSERT_EQ(orient2d(q, p, r), -expected);
+      naive_wrong += naive_orient2d(p, q, r) != expected;
+    }
+  }
+  EXPECT_GT(naive_wrong, 1000);
+}
+
+TEST(Orient2d, RandomNearCollinearMatchesTwin) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::uniform_int_distribution<int> step(-2, 2);
+  for (double offset : {0.0, 1e6}) {
+    for (int trial = 0; trial < 20000; ++trial) {
+      const Vec2 a(offset + unit(rng), offset + unit(rng));
+      const Vec2 b(offset + unit(rng), offset + unit(rng));
+      const double t = unit(rng) * 3 - 1;
+      Vec2 c = a + t * (b - a);
+      c[0] = ulp_step(c[0], step(rng));
+      c[1] = ulp_step(c[1], step(rng));
+      const int expected = exact_orient2d(a, b, c);
+      ASSERT_EQ(orient2d(a, b, c), expected);
+      ASSERT_EQ(orient2d(b, a, c), -expected);
+      ASSERT_EQ(orient2d(c, a, b), expected);
+    }
+  }
+  // Small integers, many exactly collinear.
+  std::uniform_int_distribution<int> coord(-3, 3);
+  for (int trial = 0; trial < 50000; ++trial) {
+    const Vec2 a(coord(rng), coord(rng)), b(coord(rng), coord(rng)), c(coord(rng), coord(rng));
+    const double det = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);  // exact
+    ASSERT_EQ(orient2d(a, b, c), (det > 0) - (det < 0));
+  }
+}
+
+TEST(Orient2dProjected, IsTheSignOfTheCrossProductComponent) {
+  std::mt19937_64 rng(8);
+  std::uniform_int_distribution<int> coord(-3, 3);
+  for (int trial = 0; trial < 20000; ++trial) {
+    const Vec3 a(coord(rng), coord(rng), coord(rng)), b(coord(rng), coord(rng), coord(rng)),
+        c(coord(rng), coord(rng), coord(rng));
+    const Vec3 n = (b - a).cross(c - a);  // exact for small integers
+    for (int axis = 0; axis < 3; ++axis) {
+      ASSERT_EQ(orient2d_projected(a, b, c, axis), (n[axis] > 0) - (n[axis] < 0));
+    }
+  }
+}
+
+}  // namespace
+}  // namespace vproxq
