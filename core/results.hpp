@@ -26,13 +26,23 @@ struct InterObjectDistance {
 /// Work counters of one query run on one frame.
 struct DistanceCounters {
   std::uint64_t object_pns_pairs = 0;  ///< ordered object pairs (i, j) kept by the broad phase
-  std::uint64_t candidate_pairs = 0;   ///< feature-level PNS: (triangle, object) pairs kept by culling
+  std::uint64_t feature_pns = 0;   ///< feature-level PNS: (triangle, object) pairs kept by culling
   std::uint64_t exact_tests = 0;       ///< triangle–triangle distance evaluations
 };
 
 /// Wall-clock milliseconds per stage.
 struct StageTimes {
   double load = 0, aabb = 0, voronoi = 0, exact = 0, write = 0, total = 0;
+};
+
+/// What Stage II did on one frame (absent when it did not run).
+struct VoronoiFrameStats {
+  std::array<std::int32_t, 3> grid_dims{0, 0, 0};  ///< voxels per axis
+  double cell = 0;             ///< voxel side
+  double delta = 0;            ///< Lemma 2's δ = cell diagonal / 2 + slack + δ_precision
+  double delta_precision = 0;  ///< the backend's arithmetic error bound
+  std::uint64_t sample_voxels = 0;
+  double setup_ms = 0, upload_ms = 0, compute_ms = 0, readback_ms = 0, scan_ms = 0;
 };
 
 struct ObjectInfo {
@@ -50,6 +60,7 @@ struct FrameResult {
   std::optional<std::vector<InterObjectDistance>> inter;  ///< set when "distance" ran
   DistanceCounters counters;
   StageTimes time_ms;
+  std::optional<VoronoiFrameStats> voronoi;
 };
 
 /// What a run was asked and how it ran; written once at the top of each output file.

@@ -91,7 +91,7 @@ void search_pair(const Frame& frame, const FrameBoxes& boxes, const TriangleBvh&
     const double d2 = box_distance_squared(tb_i[static_cast<size_t>(t)], box_j);
     if (d2 <= b0 * b0) self_tris.emplace_back(d2, t);
   }
-  counters.candidate_pairs += self_tris.size();
+  counters.feature_pns += self_tris.size();
   std::sort(self_tris.begin(), self_tris.end());
   for (const auto& [d2, ts] : self_tris) {
     const double b = bound();
@@ -148,7 +148,7 @@ InterDistanceOutput inter_object_distance(const Frame& frame, const FrameBoxes& 
   });
   for (const auto& c : counters) {
     out.counters.object_pns_pairs += c.object_pns_pairs;
-    out.counters.candidate_pairs += c.candidate_pairs;
+    out.counters.feature_pns += c.feature_pns;
     out.counters.exact_tests += c.exact_tests;
   }
   out.exact_ms = sw.elapsed_ms();
@@ -171,7 +171,7 @@ InterDistanceOutput inter_object_distance_brute_force(const Frame& frame) {
     }
     out.per_object[static_cast<size_t>(i)] = to_result(i, best);
   }
-  out.counters.candidate_pairs = out.counters.exact_tests;
+  out.counters.feature_pns = out.counters.exact_tests;
   return out;
 }
 

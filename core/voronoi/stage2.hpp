@@ -1,0 +1,36 @@
+#pragma once
+// Stage II host side (paper 4.4, 5.2, 5.2.1): grid, conservative voxelization of the sites,
+// bands from Stage I, a backend's 2nd-order DVD at the sample points, and from it the distance
+// bounds of Lemma 2: D_u per object and D_l per triangle.
+#include "core/broad_phase/object_broad_phase.hpp"
+#include "core/voronoi/discrete_voronoi.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace vproxq {
+
+/// Grid resolution used when none is given: 4 * cbrt(triangles), clamped to [32, 256] cells
+/// along the longest axis (paper fig. 14: the best resolution grows with scene complexity).
+int default_grid_resolution(std::int64_t triangles);
+
+struct VoronoiBounds {
+  VoronoiGrid grid;
+  double delta = 0;            ///< δ = (cell diagonal)/2 + voxelization slack + δ_precision
+  double delta_precision = 0;  ///< the backend's float error bound for this grid
+  /// D_u(O_i) = min(Stage I bound, SD~(O_i) + δ): the separation distance of object i is at
+  /// most this.
+  std::vector<double> object_upper;
+  /// D_l(f) = SD~(f) - δ per triangle: f is at least this far from every other object.
+  std::vector<std::vector<double>> triangle_lower;
+  std::uint64_t sample_voxels = 0;
+  double setup_ms = 0, upload_ms = 0, compute_ms = 0, readback_ms = 0, scan_ms = 0;
+};
+
+/// Runs Stage II on a frame. `grid_resolution` <= 0 picks default_grid_resolution().
+VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes,
+                                     const ObjectBroadPhase& stage1,
+                                     DiscreteVoronoiBackend& backend, int grid_resolution,
+                                     int threads);
+
+}  // namespace vproxq

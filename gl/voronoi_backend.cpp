@@ -1,0 +1,275 @@
+#include "gl/voronoi_backend.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/timer.hpp"
+#include "core/voronoi/bins.hpp"
+
+namespace vproxq::gl {
+
+// ---------------------------------------------------------------------------------------------
+// δ_precision of shaders/dvd2_gather.comp (float32_error_bound).
+//
+// Claim: a distance the shader reports below the band differs from the exact distance between
+// the double sample point p and the double triangle T by at most 569 * 2^-24 * E + 2^-50,
+// where every coordinate (relative to the grid origin) lies in [-E, E]. The code uses 1024.
+//
+// Model. GLSL 4.30 (4.7.1): + - * are correctly rounded but the rounding mode is undefined, so
+// each has relative error < 1 ulp <= u := 2^-23 (not 2^-24); x / y has 2.5 ulp (2.5u) for
+// |y| in [2^-126, 2^126]; sqrt is "inherited from 1/inversesqrt": (2 + 2.5) ulp = 4.5u;
+// dot(x, y) of vec3 is 3 products and 2 sums: |fl(x.y) - x.y| <= 3u sum|x_i y_i| <= 3u|x||y|.
+// Subnormals may be flushed to zero (handled at the end). `precise` keeps the compiler from
+// re-associating; contracting a*b+c into one fma only removes roundings. First-order terms
+// are kept; the O(u^2) ones are below 1e-4 of the total and are covered by the final margin.
+// All vectors below are differences of points in [-E(1+2u), E(1+2u)]^3, so every length is
+// at most D := 2 sqrt(3) E (1 + 2u); L <= D is the longest edge. "x*" is an exact quantity,
+// "x" its computed value.
+//
+// 1. Input rounding. The host rounds corners to float (to nearest): <= sqrt(3) (u/2) E each.
+//    The shader's sample point (v + 0.5) * float(cell) is off by <= (u/2 + u) per coordinate:
+//    sqrt(3) 1.5u E. The distance is 1-Lipschitz in p, and in T under moving every corner by
+//    <= r (Hausdorff distance <= r): at most 2 sqrt(3) u E = 3.5 u E. From here on p and T are
+//    the float data and d = dist(p, T).
+//
+// 2. Output. d_out = sqrt(min_j fl(v_j.v_j)) over the candidate vectors v_j: the sum of three
+//    squares has relative error 3u, sqrt 4.5u, so d_out is within (1.5u + 4.5u)|v| = 6uD of
+//    min_j |v_j|. It remains to show  d - 22.2uD <= min_j |v_j| <= d + 74uD.
+//
+// 3. Edge k, segment S = [c, c + e*], w* = p - c. The code's t lies in [0, 1] (clamp), so
+//    c + t e* is on S; v = fl(w - fl(t e)) is within 2u|w*| + 3u|e*| <= 5uD of p - (c + t e*).
+//    Hence |v| >= dist(p, S) - 5uD. For the upper side, fl(w.e) is within (2u + 3u)|w*||e*| of
+//    w*.e*, fl(e.e) within 5u of |e*|^2, the division 2.5u: the unclamped parameter is off by
+//    <= (5u|w*| + 7.5u |w*.e*|/|e*|) / |e*| <= 12.5u|w*|/|e*|; clamp is 1-Lipschitz and the
+//    distance along S is |e*|-Lipschitz in t, so |v| <= dist(p, S) + 12.5uD + 5uD.
+//
+// 4. The face. ab = fl(b - a) (longest edge by computed length, so |ac*| <= L(1 + 5u) and
+//    tau in [-O(u), 1 + O(u)]), h1 = fl(ac - fl(tau ab)) = ac - tau ab + e1, |e1| <= 3uL;
+//    mu = fl(h1.ab)/ll with |mu||ab| <= 14.5uL (h1.ab is only rounding: |h1.ab| <= 11.5uL|ab|);
+//    h = h1 - mu ab + e2, |e2| <= u|h1|; tau2 = fl(tau + mu). Define the float-defined triangle
+//    T' = (a, a + ab, a + tau2 ab + h). Its corners are within uL, and (tau2 - tau - mu)ab +
+//    (ac - ac*) + e1 + e2 <= (1 + 1 + 3 + 1)uL = 6uL, of T's: |dist(p, T') - d| <= 6uL. The
+//    plane of T' is spanned exactly by ab and h; the point the code evaluates,
+//    y = a + t ab + lambda h, lies in it exactly, whatever the rounding of t and lambda. This is
+//    what makes the frame robust: a cap's badly determined normal only tilts T' by <= 6uL at
+//    its apex, instead of making the projection inaccurate (as a cross product normal would).
+//    Lower side: computed barycentrics >= 0 imply exact ones >= -u|lambda tau2| resp.
+//    >= -(u|1 - t| + 2u|lambda (1 - tau2)|): their negative parts sum to n <= 4.01u, so y is
+//    within 2n diam(T') <= 8.1uL of T'. v = fl(fl(ap - fl(t ab)) - fl(lambda h)) is within
+//    3u|ap*| + 3u|t||ab| + 2u|lambda||h| <= 8.1uD of p - y. So |v| >= d - 6uL - 8.1uL - 8.1uD
+//    >= d - 22.2uD. With 3., every candidate is >= d - 22.2uD.
+//
+// 5. Upper side. Let x* be the point of T' nearest to p and d' = |p - x*| <= d + 6uL.
+//    (a) x* on an edge of T': that edge is within 6uL of the matching edge of T, so by 3. that
+//        edge's candidate is <= d' + 6uL + 17.5uD <= d + 29.5uD.
+//    (b) x* inside T', at distance rho from its boundary (= from the nearest edge line), and
+//        p - x* orthogonal to the plane. Edge route: some edge candidate <= sqrt(d'^2 + rho^2)
+//        + 6uL + 17.5uD <= d' + rho + 23.5uD, and rho <= |h| (the height of T' over ab).
+//        Face route: with t_p = ap*.ab/|ab|^2, lambda_p = ap*.h/|h|^2, as in 3.
+//        |t - t_p||ab| <= 9.5uD and |lambda - lambda_p||h| <= 9.5uD. ab and h are not exactly
+//        orthogonal: g = ab.h = (h1.ab - mu|ab|^2) + ab.e2, |g| <= |ab|(4u|h| + 154u^2 L); the
+//        foot's exact coordinates (t*, lambda*) in [0, 1.0002] x [0, 1] differ from (t_p,
+//        lambda_p) by lambda* g / |ab|^2 and t* g / |h|^2, i.e. in position by
+//        <= 4u|h| + 4.01uL + 155u^2 L^2 / |h|. So Pi := |y - x*| <= 27.01uD + 155u^2 L^2/|h|.
+//        The computed barycentrics are within 3.01u resp. 5.01u (lambda: exact) of y's, i.e.
+//        within 5.01uL in distance to the edge lines (times the heights <= L), and y's are
+//        within Pi of x*'s: if rho > Pi + 5.01uL the face candidate is computed and
+//        |v| <= sqrt(d'^2 + Pi^2) + 8.1uD <= d' + Pi + 8.1uD; otherwise rho <= Pi + 5.01uL.
+//        Both cases: min |v| <= d' + 23.5uD + 5.01uL + min(Pi, |h|)
+//          <= d' + 55.52uD + min(155u^2 L^2 / |h|, |h|) <= d' + 55.52uD + sqrt(155) uL
+//          <= d + 6uL + 67.97uD <= d + 74uD.
+//
+// 6. Sum: |d_out - d| <= 74uD + 6uD = 80uD for the float data; plus 1uD for flushed
+//    subnormal dot products feeding a division (an absolute 2^-126 over a divisor > 2^-100
+//    shifts t by < 2^-26 = u/8, twice), plus step 1:
+//    81 * 2 sqrt(3) (1 + 2u) u E + 3.5 u E = 284.1 u E = 568.2 * 2^-24 E.
+//    Absolute term: squared lengths <= 2^-100 are treated as 0 (edges, longest edge, height h):
+//    each such case moves the result by <= 2^-50; flushed subnormal lengths and squares add
+//    < 2^-60. The code returns 1024 * 2^-24 E + 2^-48: a margin of 1.8x for slips in the
+//    bookkeeping, still negligible next to the cell diagonal in δ (~2^-7 E at grid 128).
+// Cross-check (an off-tree experiment): a C++ float emulation of the shader's distance, run
+// under all four IEEE rounding modes on 2e6 caps (height down to 1e-12 of the length, and
+// flat), needles and slivers with the point on, near and above their planes, stays below
+// 2.1uD of the double distance of the float data; a cross-product barycentric face test on
+// the same cases is off by up to 3e5 uD. Step 5 is what the frame of the longest edge buys.
+// The top-2 selection and the band cut-off only take minima of, and compare, such values, so
+// dist1 and dist2 inherit the bound (an order statistic is 1-Lipschitz in the max norm).
+// The bin search and the bounding-box prefilter never drop a triangle that could change the
+// result (see the shader).
+// ---------------------------------------------------------------------------------------------
+double GlVoronoiBackend::float32_error_bound(double extent) {
+  return kFloat32ErrorUnits * 0x1p-24 * extent + 0x1p-48;
+}
+
+namespace {
+
+/// Largest |coordinate| of the input: triangle corners and the grid box (sample points).
+double input_extent(const DvdInput& in) {
+  double extent = in.grid.cell *
+                  static_cast<double>(*std::max_element(in.grid.dims.begin(), in.grid.dims.end()));
+  for (const double c : in.tri_xyz_d) extent = std::max(extent, std::abs(c));
+  return extent;
+}
+
+void check_addressable(const DvdInput& in) {
+  if (in.grid.voxel_count() > std::int64_t{std::numeric_limits<std::uint32_t>::max()}) {
+    throw std::invalid_argument("GlVoronoiBackend: the grid has " +
+                                std::to_string(in.grid.voxel_count()) +
+                                " voxels; the shader addresses at most 2^32 - 1");
+  }
+  for (const std::int32_t d : in.grid.dims) {
+    if (d >= (1 << 23)) {
+      throw std::invalid_argument("GlVoronoiBackend: a grid side of " + std::to_string(d) +
+                                  " voxels is not exact in float32 (limit 2^23)");
+    }
+  }
+  if (in.tri_xyz.size() != in.tri_xyz_d.size()) {
+    throw std::invalid_argument("GlVoronoiBackend: tri_xyz and tri_xyz_d differ in size");
+  }
+}
+
+ComputeProgram compile(const Context& context, const GlVoronoiOptions& options, double& ms) {
+  std::optional<ComputeProgram> program;
+  ms = finish_timed_ms(context, [&] {
+    program.emplace(ComputeProgram::from_embedded(
+        context, "dvd2_gather", {{"LOCAL_SIZE", std::to_string(options.local_size)}}));
+  });
+  return std::move(*program);
+}
+
+/// One dispatch's share of the sample voxels, with its own input and output buffers.
+struct Batch {
+  std::size_t first = 0;
+  std::size_t count = 0;
+  std::optional<StorageBuffer> samples;
+  std::optional<StorageBuffer> results;
+};
+
+}  // namespace
+
+GlVoronoiBackend::GlVoronoiBackend(const Context& context, const GlVoronoiOptions& options)
+    : context_(context), options_(options), program_(compile(context, options, compile_ms_)) {}
+
+std::string GlVoronoiBackend::device() const { return context_.renderer(); }
+
+double GlVoronoiBackend::distance_error_bound(double extent) const {
+  return float32_error_bound(extent);
+}
+
+DvdOutput GlVoronoiBackend::compute(const DvdInput& in) {
+  validate_dvd_input(in);
+  check_addressable(in);
+  DvdOutput out;
+  last_dispatch_count_ = 0;
+  const std::size_t voxel_count = in.voxels.size();
+  const std::size_t tri_count = in.tri_site.size();
+  out.site1.resize(voxel_count);
+  out.site2.resize(voxel_count);
+  out.dist1.resize(voxel_count);
+  out.dist2.resize(voxel_count);
+  if (voxel_count == 0) return out;
+
+  // Batches: at most GL_MAX_COMPUTE_WORK_GROUP_COUNT[0] groups (or the option), and per-batch
+  // buffers (16 bytes per voxel for the results) within GL_MAX_SHADER_STORAGE_BLOCK_SIZE.
+  const ContextInfo& info = context_.info();
+  const std::size_t local_size = program_.local_size()[0];
+  std::size_t groups = static_cast<std::size_t>(info.max_work_group_count[0]);
+  if (options_.max_groups_per_dispatch > 0) {
+    groups = std::min<std::size_t>(groups, options_.max_groups_per_dispatch);
+  }
+  std::size_t batch_size = local_size * groups;
+  const auto block_limit = static_cast<std::size_t>(info.max_ssbo_block_size) / 16;
+  if (block_limit > 0) batch_size = std::min(batch_size, block_limit / local_size * local_size);
+  batch_size = std::max(batch_size, local_size);
+
+  std::vector<Batch> batches;
+  for (std::size_t first = 0; first < voxel_count; first += batch_size) {
+    Batch batch;
+    batch.first = first;
+    batch.count = std::min(batch_size, voxel_count - first);
+    batches.push_back(std::move(batch));
+  }
+
+  // Upload: per-triangle info (site, first bin), samples (voxel id, band bits), the rest as is.
+  std::optional<StorageBuffer> triangles, triangle_info, bin_offsets, bin_tris;
+  out.upload_ms = finish_timed_ms(context_, [&] {
+    std::vector<std::int32_t> tri_info(4 * tri_count);
+    for (std::size_t t = 0; t < tri_count; ++t) {
+      const double* c = &in.tri_xyz_d[9 * t];
+      const Vec3 lo(std::min({c[0], c[3], c[6]}), std::min({c[1], c[4], c[7]}),
+                    std::min({c[2], c[5], c[8]}));
+      const Vec3 hi(std::max({c[0], c[3], c[6]}), std::max({c[1], c[4], c[7]}),
+                    std::max({c[2], c[5], c[8]}));
+      const BinRange range = bins_overlapping(in, lo, hi);
+      tri_info[4 * t] = in.tri_site[t];
+      for (std::size_t a = 0; a < 3; ++a) tri_info[4 * t + 1 + a] = range.lo[a];
+    }
+    triangles.emplace(StorageBuffer::from_vector(context_, in.tri_xyz));
+    triangle_info.emplace(StorageBuffer::from_vector(context_, tri_info));
+    bin_offsets.emplace(StorageBuffer::from_vector(context_, in.bin_offsets));
+    bin_tris.emplace(StorageBuffer::from_vector(context_, in.bin_tris));
+    std::vector<std::uint32_t> samples;
+    for (Batch& batch : batches) {
+      samples.resize(2 * batch.count);
+      for (std::size_t k = 0; k < batch.count; ++k) {
+        samples[2 * k] = static_cast<std::uint32_t>(in.voxels[batch.first + k]);
+        std::memcpy(&samples[2 * k + 1], &in.band[batch.first + k], sizeof(float));
+      }
+      batch.samples.emplace(StorageBuffer::from_vector(context_, samples));
+      batch.results.emplace(context_, 16 * batch.count, GL_STREAM_READ);
+    }
+  });
+
+  const double extent = input_extent(in);
+  program_.set_float("cell", static_cast<float>(in.grid.cell));
+  program_.set_int("dims_x", in.grid.dims[0]);
+  program_.set_int("dims_y", in.grid.dims[1]);
+  program_.set_int("dims_z", in.grid.dims[2]);
+  program_.set_int("bin_size", in.bin_size);
+  program_.set_int("bin_dims_x", in.bin_dims[0]);
+  program_.set_int("bin_dims_y", in.bin_dims[1]);
+  // Rounded up to float: the margin must not shrink.
+  program_.set_float("prefilter_margin",
+                     std::nextafter(static_cast<float>(2.0 * float32_error_bound(extent)),
+                                    std::numeric_limits<float>::infinity()));
+  triangles->bind(0);
+  triangle_info->bind(1);
+  bin_offsets->bind(2);
+  bin_tris->bind(3);
+
+  out.compute_ms = finish_timed_ms(context_, [&] {
+    for (const Batch& batch : batches) {
+      batch.samples->bind(4);
+      batch.results->bind(5);
+      program_.set_uint("sample_count", static_cast<GLuint>(batch.count));
+      dispatch(context_, program_, group_count(batch.count, static_cast<GLuint>(local_size)));
+      ++last_dispatch_count_;
+    }
+    memory_barrier(context_);
+  });
+
+  out.readback_ms = finish_timed_ms(context_, [&] {
+    std::vector<std::int32_t> results;
+    for (const Batch& batch : batches) {
+      results = batch.results->download_vector<std::int32_t>(4 * batch.count);
+      for (std::size_t k = 0; k < batch.count; ++k) {
+        const std::size_t o = batch.first + k;
+        out.site1[o] = results[4 * k];
+        out.site2[o] = results[4 * k + 1];
+        std::memcpy(&out.dist1[o], &results[4 * k + 2], sizeof(float));
+        std::memcpy(&out.dist2[o], &results[4 * k + 3], sizeof(float));
+      }
+    }
+  });
+  return out;
+}
+
+}  // namespace vproxq::gl
