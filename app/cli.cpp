@@ -132,7 +132,16 @@ int cli_main(int argc, char** argv) {
                  "write OUT/results.json and OUT/results.h5 (default: print a summary)");
   app.add_option("--frames", frames, "frame range A:B (0-based, B exclusive; A: or :B or A)");
   app.add_option("--voronoi", config.voronoi,
-                 "Stage II backend. Valid: off (AABB culling, then exact tests)");
+                 "Stage II (discrete Voronoi culling) backend: gpu (OpenGL compute in a headless "
+                 "EGL context), cpu (the same algorithm on the CPU), off (AABB culling only), "
+                 "auto (gpu on a hardware GPU, else cpu). Default: off. Results are identical.")
+      ->check(CLI::IsMember({"off", "cpu", "gpu", "auto"}));
+  app.add_option("--grid", config.grid,
+                 "Voronoi grid: cells along the longest axis (default: scene's \"grid\", else "
+                 "4*cbrt(triangles) clamped to [32, 256])")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--device", config.device, "EGL device index for --voronoi=gpu (default: first hardware device)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--threads", config.threads, "worker threads (default 0: all cores)")
       ->check(CLI::NonNegativeNumber);
   app.add_flag("-q,--quiet", config.quiet, "no progress or summary on the terminal");

@@ -16,8 +16,10 @@ struct Config {
   std::vector<std::string> queries;  ///< empty: scene.json's list, else {"distance"}
   std::string output_dir;            ///< empty: no files written
   FrameRange frames;
-  std::string voronoi = "off";
-  int threads = 0;  ///< 0: all hardware threads
+  std::string voronoi = "off";  ///< off | cpu | gpu | auto (see README: off is fastest today)
+  int grid = 0;                  ///< cells along the longest axis; 0: scene's "grid", else automatic
+  int device = -1;               ///< EGL device index for gpu; -1: prefer a hardware device
+  int threads = 0;               ///< 0: all hardware threads
   bool quiet = false;
 };
 

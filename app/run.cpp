@@ -4,6 +4,9 @@
 #include "core/parallel.hpp"
 #include "core/query/inter_distance.hpp"
 #include "core/timer.hpp"
+#include "core/voronoi/stage2.hpp"
+#include "gl/egl_context.hpp"
+#include "gl/voronoi_backend.hpp"
 #include "io/output.hpp"
 #include "io/scene_source.hpp"
 
@@ -69,12 +72,40 @@ void print_summary(const FrameResult& r) {
   }
 }
 
+/// The Stage II backend of a run, and the GL context it may need (destroyed after it).
+struct VoronoiStage {
+  std::optional<gl::Context> context;
+  std::unique_ptr<DiscreteVoronoiBackend> backend;
+};
+
+VoronoiStage make_voronoi_stage(const Config& config, int threads) {
+  VoronoiStage stage;
+  if (config.voronoi == "off") return stage;
+  gl::ContextOptions opts;
+  opts.device_index = config.device;
+  if (config.voronoi == "gpu") {
+    stage.context.emplace(gl::create_context(opts));  // RuntimeError naming the failed call
+  } else if (config.voronoi == "auto") {
+    gl::ContextResult r = gl::try_create_context(opts);
+    if (!r) {
+      if (!config.quiet) std::fprintf(stderr, "vproxq: note: no GPU context (%s); using --voronoi=cpu\n", r.error.c_str());
+    } else if (r.context->info().software) {
+      // A software rasterizer (llvmpipe) is slower than the CPU twin: auto takes the CPU.
+      if (!config.quiet) std::fprintf(stderr, "vproxq: note: only a software GL renderer (%s); using --voronoi=cpu\n", r.context->renderer().c_str());
+    } else {
+      stage.context.emplace(std::move(*r.context));
+    }
+  }
+  if (stage.context)
+    stage.backend = std::make_unique<gl::GlVoronoiBackend>(*stage.context);
+  else
+    stage.backend = make_cpu_voronoi_backend(threads);
+  return stage;
+}
+
 }  // namespace
 
 void run(const Config& config) {
-  if (config.voronoi != "off")
-    throw UsageError("--voronoi " + config.voronoi +
-                     ": the Voronoi stage is not available in this version; valid values: off");
   const SceneSource scene = SceneSource::open(config.scene_path);
 
   std::vector<std::string> queries =
@@ -97,6 +128,11 @@ void run(const Config& config) {
   info.voronoi = config.voronoi;
   info.threads = resolve_threads(config.threads);
   info.frame_count = static_cast<std::size_t>(last - first);
+  const int grid = config.grid > 0 ? config.grid : scene.grid().value_or(0);
+  VoronoiStage voronoi = make_voronoi_stage(config, info.threads);
+  info.voronoi = voronoi.backend ? voronoi.backend->name() : "off";
+  info.device = voronoi.backend ? voronoi.backend->device() : "";
+  info.grid = voronoi.backend ? grid : 0;
 
   std::unique_ptr<ResultWriter> writer;
   if (!config.output_dir.empty()) writer = std::make_unique<ResultWriter>(config.output_dir, info);
@@ -116,8 +152,31 @@ void run(const Config& config) {
       result.objects.push_back({static_cast<Index>(i), o.name, o.num_vertices(), o.num_triangles(), o.is_static});
     }
     if (want_distance) {
-      InterDistanceOutput d = inter_object_distance(frame, {info.threads});
-      result.time_ms.aabb = d.aabb_ms;
+      sw.restart();
+      const FrameBoxes boxes = FrameBoxes::compute(frame, info.threads);
+      const ObjectBroadPhase stage1 = object_broad_phase(frame, boxes, info.threads);
+      result.time_ms.aabb = sw.elapsed_ms();
+      InterDistanceOptions opts{info.threads, nullptr};
+      VoronoiBounds bounds;
+      if (voronoi.backend) {
+        sw.restart();
+        bounds = compute_voronoi_bounds(frame, boxes, stage1, *voronoi.backend, grid, info.threads);
+        result.time_ms.voronoi = sw.elapsed_ms();
+        opts.voronoi = &bounds;
+        VoronoiFrameStats v;
+        v.grid_dims = bounds.grid.dims;
+        v.cell = bounds.grid.cell;
+        v.delta = bounds.delta;
+        v.delta_precision = bounds.delta_precision;
+        v.sample_voxels = bounds.sample_voxels;
+        v.setup_ms = bounds.setup_ms;
+        v.upload_ms = bounds.upload_ms;
+        v.compute_ms = bounds.compute_ms;
+        v.readback_ms = bounds.readback_ms;
+        v.scan_ms = bounds.scan_ms;
+        result.voronoi = v;
+      }
+      InterDistanceOutput d = inter_object_distance(frame, boxes, stage1, opts);
       result.time_ms.exact = d.exact_ms;
       result.counters = d.counters;
       result.inter = std::move(d.per_object);

@@ -135,10 +135,10 @@ struct Hdf5ResultWriter::Impl {
                       H5Pclose);
     group_creation = Handle(check_id(H5Pcreate(H5P_GROUP_CREATE), "H5Pcreate", "group list"),
                             H5Pclose);
-    // The stats group has 9 attributes; past HDF5's default of 8 each group would get its own
+    // The stats group has up to 19 attributes; past HDF5's default of 8 each group would get its own
     // dense attribute storage (a fractal heap and a B-tree), slower and larger on disk.
-    constexpr unsigned kCompactAttributes = 16;
-    constexpr unsigned kDenseAttributes = 12;
+    constexpr unsigned kCompactAttributes = 24;
+    constexpr unsigned kDenseAttributes = 20;
     check_ok(H5Pset_attr_phase_change(group_creation.get(), kCompactAttributes, kDenseAttributes),
              "H5Pset_attr_phase_change", "group list");
   }
@@ -321,8 +321,22 @@ struct Hdf5ResultWriter::Impl {
     write_attribute(s, stats_where, "time_ms_total", t.total);
     write_attribute(s, stats_where, "exact_tests", std::uint64_t{frame.counters.exact_tests});
     write_attribute(s, stats_where, "pns_pairs", std::uint64_t{frame.counters.object_pns_pairs});
-    write_attribute(s, stats_where, "candidate_pairs",
-                    std::uint64_t{frame.counters.candidate_pairs});
+    write_attribute(s, stats_where, "feature_pns",
+                    std::uint64_t{frame.counters.feature_pns});
+    if (frame.voronoi) {
+      const VoronoiFrameStats& v = *frame.voronoi;
+      for (int k = 0; k < 3; ++k) {
+        const std::string name = std::string("voronoi_grid_") + "xyz"[k];
+        write_attribute(s, stats_where, name.c_str(), std::int32_t{v.grid_dims[static_cast<size_t>(k)]});
+      }
+      write_attribute(s, stats_where, "voronoi_cell", v.cell);
+      write_attribute(s, stats_where, "voronoi_delta", v.delta);
+      write_attribute(s, stats_where, "voronoi_delta_precision", v.delta_precision);
+      write_attribute(s, stats_where, "voronoi_sample_voxels", std::uint64_t{v.sample_voxels});
+      write_attribute(s, stats_where, "voronoi_time_ms_upload", v.upload_ms);
+      write_attribute(s, stats_where, "voronoi_time_ms_compute", v.compute_ms);
+      write_attribute(s, stats_where, "voronoi_time_ms_readback", v.readback_ms);
+    }
     close_checked(stats, "H5Gclose", stats_where);
   }
 };

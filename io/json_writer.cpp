@@ -122,7 +122,19 @@ Json frame_json(const FrameResult& frame, double write_ms) {
   stats["time_ms"] = std::move(time_ms);
   stats["exact_tests"] = frame.counters.exact_tests;
   stats["pns_pairs"] = frame.counters.object_pns_pairs;
-  stats["candidate_pairs"] = frame.counters.candidate_pairs;
+  stats["feature_pns"] = frame.counters.feature_pns;
+  if (frame.voronoi) {
+    const VoronoiFrameStats& v = *frame.voronoi;
+    Json vj;
+    vj["grid"] = {v.grid_dims[0], v.grid_dims[1], v.grid_dims[2]};
+    vj["cell"] = v.cell;
+    vj["delta"] = v.delta;
+    vj["delta_precision"] = v.delta_precision;
+    vj["sample_voxels"] = v.sample_voxels;
+    vj["time_ms"] = {{"setup", v.setup_ms}, {"upload", v.upload_ms}, {"compute", v.compute_ms},
+                     {"readback", v.readback_ms}, {"scan", v.scan_ms}};
+    stats["voronoi"] = std::move(vj);
+  }
   j["stats"] = std::move(stats);
   return j;
 }

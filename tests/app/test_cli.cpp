@@ -306,3 +306,47 @@ TEST(Generator, RegeneratesTheCommittedSampleSceneByteForByte) {
 
 }  // namespace
 }  // namespace vproxq
+
+namespace vproxq {
+namespace {
+
+TEST(CliVoronoi, BackendsGiveIdenticalResultsEqualToBruteForce) {
+  for (const char* name : {"two-cubes", "blobs-small"}) {
+    SCOPED_TRACE(name);
+    ScratchDir dir;
+    const auto scene = kSamples / name / "scene.json";
+    for (const char* backend : {"off", "cpu", "gpu"}) {
+      const auto out = dir / backend;
+      const auto r = vproxq(quote(scene) + " -o " + quote(out) + " --quiet --threads 2 --grid 48 --voronoi=" + backend);
+      ASSERT_EQ(r.exit_code, 0) << backend << ": " << r.output;
+      const auto j = read_json(out / "results.json");
+      EXPECT_EQ(j["settings"]["voronoi"].get<std::string>(), backend);
+      if (std::string(backend) != "off") {
+        EXPECT_EQ(j["frames"][0]["stats"]["voronoi"]["grid"].size(), 3u);
+        EXPECT_GT(j["frames"][0]["stats"]["voronoi"]["delta"].get<double>(), 0.0);
+      }
+      expect_results_equal_brute_force(scene, out / "results.json");
+    }
+    for (const char* backend : {"cpu", "gpu"}) {
+      const auto r = vproxq("diff " + quote(dir / "off" / "results.json") + " " + quote(dir / backend / "results.json"));
+      EXPECT_EQ(r.exit_code, 0) << backend << ": " << r.output;
+    }
+  }
+}
+
+TEST(CliVoronoi, WithoutEglAutoFallsBackToCpuAndGpuFails) {
+  ScratchDir dir;
+  const std::string env = "VPROXQ_EGL_LIBRARY=libvproxq-no-such-egl.so.1 ";
+  const auto scene = quote(kSamples / "two-cubes" / "scene.json");
+  auto r = run_command(env + kVproxq + " " + scene + " --voronoi=auto -o " + quote(dir / "auto"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("using --voronoi=cpu"), std::string::npos) << r.output;
+  EXPECT_EQ(read_json(dir / "auto" / "results.json")["settings"]["voronoi"].get<std::string>(), "cpu");
+  r = run_command(env + kVproxq + " " + scene + " --voronoi=gpu -o " + quote(dir / "gpu"));
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  EXPECT_NE(r.output.find("libvproxq-no-such-egl.so.1"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "gpu" / "results.json"));
+}
+
+}  // namespace
+}  // namespace vproxq

@@ -264,7 +264,7 @@ TEST_F(OutputTest, JsonFramesHoldEveryValueAndDoublesRoundTripBitwise) {
 
     const json& stats = jf["stats"];
     EXPECT_EQ(keys_of(stats), (std::set<std::string>{"time_ms", "exact_tests", "pns_pairs",
-                                                     "candidate_pairs"}));
+                                                     "feature_pns"}));
     EXPECT_EQ(keys_of(stats["time_ms"]), (std::set<std::string>{"load", "aabb", "voronoi",
                                                                 "exact", "write", "total"}));
     EXPECT_EQ(stats["time_ms"]["load"].get<double>(), f.time_ms.load);
@@ -280,7 +280,7 @@ TEST_F(OutputTest, JsonFramesHoldEveryValueAndDoublesRoundTripBitwise) {
     EXPECT_NE(write, 99.0);
     EXPECT_EQ(stats["exact_tests"].get<std::uint64_t>(), f.counters.exact_tests);
     EXPECT_EQ(stats["pns_pairs"].get<std::uint64_t>(), f.counters.object_pns_pairs);
-    EXPECT_EQ(stats["candidate_pairs"].get<std::uint64_t>(), f.counters.candidate_pairs);
+    EXPECT_EQ(stats["feature_pns"].get<std::uint64_t>(), f.counters.feature_pns);
   }
 }
 
@@ -409,7 +409,7 @@ TEST_F(OutputTest, Hdf5FramesHoldEveryValue) {
 
     const std::string s = g + "/stats";
     EXPECT_EQ(h5.attribute_names(s),
-              (std::vector<std::string>{"candidate_pairs", "exact_tests", "pns_pairs",
+              (std::vector<std::string>{"exact_tests", "feature_pns", "pns_pairs",
                                         "time_ms_aabb", "time_ms_exact", "time_ms_load",
                                         "time_ms_total", "time_ms_voronoi", "time_ms_write"}));
     EXPECT_EQ(h5.double_attribute(s, "time_ms_load"), f.time_ms.load);
@@ -420,7 +420,7 @@ TEST_F(OutputTest, Hdf5FramesHoldEveryValue) {
     EXPECT_GE(h5.double_attribute(s, "time_ms_write"), 0.0);
     EXPECT_EQ(h5.uint_attribute(s, "exact_tests"), f.counters.exact_tests);
     EXPECT_EQ(h5.uint_attribute(s, "pns_pairs"), f.counters.object_pns_pairs);
-    EXPECT_EQ(h5.uint_attribute(s, "candidate_pairs"), f.counters.candidate_pairs);
+    EXPECT_EQ(h5.uint_attribute(s, "feature_pns"), f.counters.feature_pns);
   }
 }
 

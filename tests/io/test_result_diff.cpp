@@ -35,12 +35,12 @@ Json base_document() {
           "points": [[0, 0, 0.5], [0, 0, 0]]}]},
        "stats": {"time_ms": {"load": 1, "aabb": 2, "voronoi": 3, "exact": 4, "write": 5,
                              "total": 15}, "exact_tests": 1, "pns_pairs": 2,
-                 "candidate_pairs": 1}},
+                 "feature_pns": 1}},
       {"frame": 1,
        "objects": [{"id": 0, "name": "a", "vertices": 3, "triangles": 1}],
        "stats": {"time_ms": {"load": 1, "aabb": 0, "voronoi": 0, "exact": 0, "write": 1,
                              "total": 2}, "exact_tests": 0, "pns_pairs": 0,
-                 "candidate_pairs": 0}},
+                 "feature_pns": 0}},
       {"frame": 3,
        "objects": [{"id": 0, "name": "a", "vertices": 3, "triangles": 1}],
        "distance": {"inter": [
@@ -48,7 +48,7 @@ Json base_document() {
           "points": null}]},
        "stats": {"time_ms": {"load": 1, "aabb": 0, "voronoi": 0, "exact": 0, "write": 1,
                              "total": 2}, "exact_tests": 0, "pns_pairs": 0,
-                 "candidate_pairs": 0}}
+                 "feature_pns": 0}}
     ]})");
 }
 
