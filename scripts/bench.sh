@@ -22,22 +22,8 @@ frames=${FRAMES:-5}
 seed=${SEED:-1}
 jobs=${JOBS:-$(nproc 2>/dev/null || echo 2)}
 
-if ! dpkg-query -W -f='${Status}' libfcl-dev 2>/dev/null | grep -q "install ok installed"; then
-  echo "bench.sh: installing libfcl-dev (FCL, the benchmark's peer library)"
-  if [ "$(id -u)" = 0 ]; then
-    sudo=()
-  elif command -v sudo >/dev/null 2>&1; then
-    sudo=(sudo)
-  else
-    echo "bench.sh: need root or sudo to install libfcl-dev (or install it yourself)" >&2
-    exit 1
-  fi
-  export DEBIAN_FRONTEND=noninteractive
-  if ! "${sudo[@]}" apt-get install -y --no-install-recommends libfcl-dev; then
-    "${sudo[@]}" apt-get update
-    "${sudo[@]}" apt-get install -y --no-install-recommends libfcl-dev
-  fi
-fi
+# FCL and the other Debian packages: the setup script installs what is missing.
+bash scripts/setup.sh --bench --no-build
 
 cmake -S . -B build-bench -DCMAKE_BUILD_TYPE=Release -DVPROXQ_BUILD_BENCH=ON \
   -DVPROXQ_BUILD_TESTS=OFF

@@ -22,22 +22,13 @@
 #include "core/geometry/point_triangle.hpp"
 #include "core/voronoi/bins.hpp"
 #include "core/voronoi/discrete_voronoi.hpp"
+#include "support/dvd_input.hpp"
 
 namespace vproxq {
 namespace {
 
-Triangle triangle_of(const DvdInput& in, std::size_t t) {
-  const double* c = &in.tri_xyz_d[9 * t];
-  return {Vec3(c[0], c[1], c[2]), Vec3(c[3], c[4], c[5]), Vec3(c[6], c[7], c[8])};
-}
-
-Vec3 sample_point(const VoronoiGrid& grid, std::int64_t id) {
-  const std::int64_t x = id % grid.dims[0];
-  const std::int64_t y = (id / grid.dims[0]) % grid.dims[1];
-  const std::int64_t z = id / (std::int64_t{grid.dims[0]} * grid.dims[1]);
-  return grid.cell * Vec3(static_cast<double>(x) + 0.5, static_cast<double>(y) + 0.5,
-                          static_cast<double>(z) + 0.5);
-}
+using test::sample_point;
+using test::triangle_of;
 
 void add_triangle(DvdInput& in, const Triangle& t, std::int32_t site) {
   for (const Vec3& c : t) {
