@@ -1,0 +1,96 @@
+// Adjacency (1-ring, 2-ring, edges) against definitions evaluated pair by pair.
+#include "core/mesh/adjacency.hpp"
+#include "support/random_scene.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+
+namespace vproxq {
+namespace {
+
+std::vector<Index> to_vector(IndexSpan s) { return {s.begin(), s.end()}; }
+
+/// The rings by their definitions, O(T^2).
+void check_against_definitions(const Topology& topo) {
+  const Adjacency& adj = adjacency(topo);
+  const Index nt = topo.num_triangles();
+  for (Index t = 0; t < nt; ++t) {
+    std::vector<Index> r1, r2;
+    for (Index g = 0; g < nt; ++g)
+      if (g != t && Adjacency::share_vertex(topo.faces[static_cast<size_t>(t)], topo.faces[static_cast<size_t>(g)]))
+        r1.push_back(g);
+    for (Index g = 0; g < nt; ++g) {
+      if (g == t || std::binary_search(r1.begin(), r1.end(), g)) continue;
+      bool via = false;
+      for (Index h : r1) via = via || Adjacency::share_vertex(topo.faces[static_cast<size_t>(h)], topo.faces[static_cast<size_t>(g)]);
+      if (via) r2.push_back(g);
+    }
+    ASSERT_EQ(to_vector(adj.ring1(t)), r1) << "triangle " << t;
+    ASSERT_EQ(to_vector(adj.ring2(t)), r2) << "triangle " << t;
+  }
+  std::set<std::pair<Index, Index>> edges;
+  for (const Face& f : topo.faces)
+    for (int k = 0; k < 3; ++k) {
+      const Index a = f[static_cast<size_t>(k)], b = f[static_cast<size_t>((k + 1) % 3)];
+      if (a != b) edges.insert({std::min(a, b), std::max(a, b)});
+    }
+  ASSERT_EQ(adj.edges().size(), edges.size());
+  for (size_t e = 0; e < adj.edges().size(); ++e) {
+    const auto& [a, b] = adj.edges()[e];
+    EXPECT_LT(a, b);
+    EXPECT_TRUE(edges.count({a, b}));
+    if (e > 0) {
+      const auto& p = adj.edges()[e - 1];
+      EXPECT_TRUE(p[1] < b || (p[1] == b && p[0] < a)) << "edges sorted by (b, a)";
+    }
+    EXPECT_EQ(adj.find_edge(b, a), static_cast<Index>(e));
+    for (Index t : adj.edge_triangles(static_cast<Index>(e))) {
+      const Face& f = topo.faces[static_cast<size_t>(t)];
+      EXPECT_TRUE(std::count(f.begin(), f.end(), a) && std::count(f.begin(), f.end(), b));
+    }
+  }
+  for (Index v = 0; v < topo.num_vertices; ++v)
+    for (Index t : adj.vertex_triangles(v)) {
+      const Face& f = topo.faces[static_cast<size_t>(t)];
+      EXPECT_TRUE(std::count(f.begin(), f.end(), v));
+    }
+}
+
+TEST(Adjacency, RandomBlobsMatchDefinitions) {
+  test::Rng rng(7);
+  for (int k = 0; k < 3; ++k) {
+    const Object o = test::make_blob(rng, Vec3::Zero(), 1.0, 1, 0.3, "b");
+    check_against_definitions(*o.topology);
+  }
+}
+
+TEST(Adjacency, IrregularMeshes) {
+  // A strip with a boundary, a non-manifold fan of 3 triangles on edge (0,1), a duplicate
+  // triangle, a degenerate face and an isolated vertex (9).
+  Topology topo;
+  topo.num_vertices = 10;
+  topo.faces = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}, {2, 1, 5}, {2, 1, 5}, {5, 6, 7}, {7, 8, 8}, {6, 7, 8}};
+  check_against_definitions(topo);
+  const Adjacency& adj = adjacency(topo);
+  EXPECT_EQ(adj.edge_triangles(adj.find_edge(0, 1)).size(), 3u);  // non-manifold edge
+  EXPECT_TRUE(adj.vertex_triangles(9).empty());                   // isolated vertex
+  EXPECT_EQ(adj.triangle_edges(6)[1], kNoIndex);                  // (8, 8) is no edge
+  EXPECT_EQ(adj.find_edge(3, 9), kNoIndex);
+}
+
+TEST(Adjacency, CachedPerTopologyAndResetOnCopy) {
+  Topology topo;
+  topo.num_vertices = 4;
+  topo.faces = {{0, 1, 2}, {0, 2, 3}};
+  const Adjacency* a = &adjacency(topo);
+  EXPECT_EQ(a, &adjacency(topo));
+  Topology copy = topo;
+  copy.faces.push_back({1, 2, 3});
+  EXPECT_EQ(adjacency(copy).ring1(2).size(), 2u);
+  EXPECT_EQ(adjacency(topo).ring1(0).size(), 1u);
+}
+
+}  // namespace
+}  // namespace vproxq
