@@ -27,6 +27,17 @@ struct Best {
   bool improved_by(double d, Index o, Index ts, Index to) const {
     return std::tie(d, o, ts, to) < std::tie(distance, other, tri_self, tri_other);
   }
+
+  /// Once the answer is a contact (distance 0), no pair can be strictly closer, so only a
+  /// pair with smaller ids can still win the tie-break: (o, ts, to) lexicographically before
+  /// the current ones. Pairs failing this need no exact test.
+  bool contact_prunes(Index o) const { return distance == 0 && o > other; }
+  bool contact_prunes(Index o, Index ts) const {
+    return distance == 0 && (o > other || (o == other && ts > tri_self));
+  }
+  bool contact_prunes(Index o, Index ts, Index to) const {
+    return distance == 0 && std::tie(o, ts, to) > std::tie(other, tri_self, tri_other);
+  }
 };
 
 /// Distance between triangle ts of object i and triangle to of object j, always evaluated
@@ -96,8 +107,10 @@ void search_pair(const Frame& frame, const FrameBoxes& boxes, const TriangleBvh&
   for (const auto& [d2, ts] : self_tris) {
     const double b = bound();
     if (d2 > b * b) break;
+    if (best.contact_prunes(j, ts)) continue;
     bvh_j.query(tb_i[static_cast<size_t>(ts)], bound, [&](Index to, double) {
       if (low_j && low_j[to] > bound()) return;
+      if (best.contact_prunes(j, ts, to)) return;
       consider(frame, i, ts, j, to, best);
       ++counters.exact_tests;
     });
@@ -140,6 +153,7 @@ InterDistanceOutput inter_object_distance(const Frame& frame, const FrameBoxes& 
       if (box_distance_squared(boxes.objects[ui], boxes.objects[static_cast<size_t>(j)]) >
           bound * bound)
         break;  // PNS is sorted by box distance
+      if (best.contact_prunes(j)) continue;
       ++counters[ui].object_pns_pairs;
       search_pair(frame, boxes, bvhs[static_cast<size_t>(j)], i, j, u, slack, opts.voronoi, best,
                   self_tris, counters[ui]);
