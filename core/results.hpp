@@ -71,8 +71,8 @@ enum class PdStatus : std::uint8_t {
   NonManifold = 2,    ///< an object has an edge used by three or more faces
   NonOrientable = 3,  ///< an edge is used twice in the same direction: no consistent inside
   TooDeep = 4,        ///< the overlap holds a whole connected part of an object: no local answer
-  Shallow = 5,        ///< no vertex of either object lies inside the other (overlap thinner
-                      ///< than the mesh sampling): no overlapping feature to measure from
+  Shallow = 5,        ///< no vertex lies strictly inside the other object and no overlapping
+                      ///< triangle has a normal (all degenerate): no direction to measure along
   SelfIntersection = 6,  ///< a self-intersecting object: not computed in this version
 };
 
@@ -99,7 +99,8 @@ struct PenetrationDepth {
   /// negative); meaningful only when status is Ok.
   Vec3 direction = Vec3::Zero();
   /// The closest-feature pair of maximal distance that gave the direction: a vertex of
-  /// deepest_object inside the other object, and its nearest point on the other's surface.
+  /// deepest_object inside the other object, and its nearest point on the other's surface
+  /// (kNoIndex when the direction came from a face normal: no vertex strictly inside).
   Index deepest_object = kNoIndex;
   Index deepest_vertex = kNoIndex;
   Vec3 deepest_point = Vec3::Zero();    ///< the vertex

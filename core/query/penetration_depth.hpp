@@ -32,8 +32,13 @@ struct PenetrationDepthOutput {
 ///     ray so that crossings through B's edges and vertices count once). A walk that never
 ///     meets an outside vertex has swallowed a whole part of A: status too_deep.
 ///  3. T: for every inside vertex, its nearest point on the other object (point–triangle
-///     distance through the other object's BVH); the pair of maximal distance gives T.
-///     Without any inside vertex: status shallow.
+///     distance through the other object's BVH); the pair of maximal distance gives T, as the
+///     translation of objects[0] that brings that vertex (or its nearest point) back out.
+///     When no vertex lies strictly inside (every such distance is 0: faces lying on each
+///     other, or an overlap thinner than the mesh's edges), T is instead the unit normal of an
+///     overlapping triangle along which the points of step 4 are narrowest (pointing out of
+///     objects[1]); deepest_vertex is then kNoIndex. Status shallow only when no overlapping
+///     triangle has a normal (all degenerate).
 ///  4. Depth: max - min of the projections on T of the inside vertices of both objects and of
 ///     the vertices of the intersection segments/polygons of the intersecting triangle pairs
 ///     (together, the vertices of the overlap region's boundary near the contact).
