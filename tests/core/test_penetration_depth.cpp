@@ -3,6 +3,7 @@
 // error of r1 + r2 - |c1 - c2|), the exact inside test, and the statuses where PD is undefined.
 #include "core/query/intersecting_pairs.hpp"
 #include "core/geometry/point_triangle.hpp"
+#include "core/mesh/adjacency.hpp"
 #include "core/query/penetration_depth.hpp"
 #include "support/random_scene.hpp"
 
@@ -407,6 +408,56 @@ TEST(PenetrationDepth, UndefinedCasesGetAStatus) {
     EXPECT_EQ(pd[0].objects, (std::array<Index, 2>{0, 0}));
     EXPECT_EQ(pd[0].status, PdStatus::SelfIntersection);
   }
+}
+
+TEST(PenetrationDepth, InsideVerticesAreTheWalkClosureOfBruteForceWinding) {
+  // On random overlapping blobs: the listed vertices of each side are exactly those reached
+  // from the intersecting triangles' vertices through vertices inside the other object, with
+  // "inside" from the brute-force winding number (every face, no BVH).
+  size_t checked = 0, ok = 0;
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    const Frame frame = test::make_random_frame(seed, 4, 1.0, 2);
+    const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
+    const auto pairs = intersecting_pairs(frame, boxes, {2, nullptr, false}).pairs;
+    const auto pd = penetration_depth(frame, boxes, pairs, {2}).pairs;
+    for (const PenetrationDepth& e : pd) {
+      SCOPED_TRACE("seed " + std::to_string(seed) + " objects " + std::to_string(e.objects[0]) + "," + std::to_string(e.objects[1]));
+      if (e.status != PdStatus::Ok && e.status != PdStatus::TooDeep) continue;
+      if (e.status == PdStatus::Ok) {
+        ++ok;
+        EXPECT_GE(e.depth, 0.0);
+        EXPECT_NEAR(e.direction.norm(), 1.0, 1e-12);
+      }
+      for (int side = 0; side < 2; ++side) {
+        const Object& own = frame.objects[static_cast<size_t>(e.objects[static_cast<size_t>(side)])];
+        const Object& other = frame.objects[static_cast<size_t>(e.objects[static_cast<size_t>(1 - side)])];
+        auto inside = [&](Index v) {
+          bool on = false;
+          const int w = winding_number_brute_force(own.positions[static_cast<size_t>(v)], other, on);
+          return !on && w != 0;
+        };
+        const auto& list = e.inside_vertices[static_cast<size_t>(side)];
+        auto listed = [&](Index v) { return std::binary_search(list.begin(), list.end(), v); };
+        for (Index v : list) EXPECT_TRUE(inside(v)) << "vertex " << v;
+        for (const IntersectingPair& p : pairs) {  // seeds
+          if (p.object_a != e.objects[0] || p.object_b != e.objects[1]) continue;
+          for (Index v : own.topology->faces[static_cast<size_t>(side == 0 ? p.tri_a : p.tri_b)])
+            EXPECT_EQ(listed(v), inside(v)) << "seed vertex " << v;
+        }
+        const Adjacency& adj = adjacency(*own.topology);
+        for (Index v : list)  // closed under inside neighbours
+          for (Index t : adj.vertex_triangles(v))
+            for (Index u : own.topology->faces[static_cast<size_t>(t)])
+              if (!listed(u)) {
+                EXPECT_FALSE(inside(u)) << "neighbour " << u << " of " << v;
+              }
+        checked += list.size();
+      }
+    }
+  }
+  std::printf("[ blobs ] %zu pd entries ok, %zu inside vertices checked\n", ok, checked);
+  EXPECT_GT(checked, 50u);
+  EXPECT_GT(ok, 3u);
 }
 
 TEST(PenetrationDepth, NoIntersectionNoEntry) {
