@@ -45,6 +45,72 @@ struct VoronoiFrameStats {
   double setup_ms = 0, upload_ms = 0, compute_ms = 0, readback_ms = 0, scan_ms = 0;
 };
 
+/// One intersecting triangle pair (closed triangles sharing a point, decided exactly).
+/// Canonical: object_a <= object_b, and tri_a < tri_b when the objects are the same (an
+/// intra-object pair: two triangles of one object that share no vertex).
+struct IntersectingPair {
+  Index object_a = kNoIndex, tri_a = kNoIndex, object_b = kNoIndex, tri_b = kNoIndex;
+
+  bool operator==(const IntersectingPair& o) const {
+    return object_a == o.object_a && tri_a == o.tri_a && object_b == o.object_b && tri_b == o.tri_b;
+  }
+  bool operator!=(const IntersectingPair& o) const { return !(*this == o); }
+  /// Lexicographic (object_a, object_b, tri_a, tri_b): the order of the written list.
+  bool operator<(const IntersectingPair& o) const {
+    if (object_a != o.object_a) return object_a < o.object_a;
+    if (object_b != o.object_b) return object_b < o.object_b;
+    if (tri_a != o.tri_a) return tri_a < o.tri_a;
+    return tri_b < o.tri_b;
+  }
+};
+
+/// Outcome of the local penetration depth of one object pair (README, "Penetration depth").
+enum class PdStatus : std::uint8_t {
+  Ok = 0,             ///< depth and direction computed
+  OpenSurface = 1,    ///< an object has a boundary edge (used by one face): no inside
+  NonManifold = 2,    ///< an object has an edge used by three or more faces
+  NonOrientable = 3,  ///< an edge is used twice in the same direction: no consistent inside
+  TooDeep = 4,        ///< the overlap holds a whole connected part of an object: no local answer
+  Shallow = 5,        ///< no vertex lies strictly inside the other object and no overlapping
+                      ///< triangle has a normal (all degenerate): no direction to measure along
+  SelfIntersection = 6,  ///< a self-intersecting object: not computed in this version
+};
+
+/// Stable text of a PdStatus (JSON "status", README).
+inline const char* pd_status_name(PdStatus s) {
+  switch (s) {
+    case PdStatus::Ok: return "ok";
+    case PdStatus::OpenSurface: return "open_surface";
+    case PdStatus::NonManifold: return "non_manifold";
+    case PdStatus::NonOrientable: return "non_orientable";
+    case PdStatus::TooDeep: return "too_deep";
+    case PdStatus::Shallow: return "shallow";
+    case PdStatus::SelfIntersection: return "self_intersection";
+  }
+  return "unknown";
+}
+
+/// Local penetration depth of one intersecting object pair (paper 3.3).
+struct PenetrationDepth {
+  std::array<Index, 2> objects{kNoIndex, kNoIndex};  ///< objects[0] <= objects[1]
+  PdStatus status = PdStatus::Ok;
+  double depth = 0;  ///< meaningful only when status is Ok
+  /// Unit translation of objects[0] that undoes the penetration (objects[1] moves by its
+  /// negative); meaningful only when status is Ok.
+  Vec3 direction = Vec3::Zero();
+  /// The closest-feature pair of maximal distance that gave the direction: a vertex of
+  /// deepest_object inside the other object, and its nearest point on the other's surface
+  /// (kNoIndex when the direction came from a face normal: no vertex strictly inside).
+  Index deepest_object = kNoIndex;
+  Index deepest_vertex = kNoIndex;
+  Vec3 deepest_point = Vec3::Zero();    ///< the vertex
+  Vec3 nearest_point = Vec3::Zero();    ///< its nearest point on the other object
+  /// Overlapping features, ascending ids: vertices of objects[k] inside objects[1-k], and the
+  /// triangles of objects[k] that intersect objects[1-k] or touch such a vertex.
+  std::array<std::vector<Index>, 2> inside_vertices;
+  std::array<std::vector<Index>, 2> overlapping_triangles;
+};
+
 struct ObjectInfo {
   Index id = 0;
   std::string name;
@@ -58,6 +124,10 @@ struct FrameResult {
   std::vector<std::string> files;
   std::vector<ObjectInfo> objects;
   std::optional<std::vector<InterObjectDistance>> inter;  ///< set when "distance" ran
+  /// Every intersecting triangle pair, sorted (set when "distance" or "pd" ran).
+  std::optional<std::vector<IntersectingPair>> intersecting_pairs;
+  std::uint64_t intersection_tests = 0;  ///< exact triangle–triangle intersection tests
+  std::optional<std::vector<PenetrationDepth>> pd;  ///< set when "pd" ran; one per object pair
   DistanceCounters counters;
   StageTimes time_ms;
   std::optional<VoronoiFrameStats> voronoi;

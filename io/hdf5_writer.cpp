@@ -35,6 +35,23 @@ struct InterRow {
   std::uint8_t kind;  // field "case"
 };
 
+struct PairRow {  // one intersecting triangle pair
+  std::int32_t object_a, tri_a, object_b, tri_b;
+};
+
+struct PdRow {  // one object pair's penetration depth
+  std::int32_t object_a, object_b;
+  std::uint8_t status;  // PdStatus code (README)
+  double depth;         // NaN unless status is 0 (ok)
+  double direction[3];
+  std::int32_t deepest_object, deepest_vertex;  // -1: direction from a face normal
+  double deepest_point[3], nearest_point[3];
+};
+
+struct FeatureRow {  // one overlapping feature of one pd row
+  std::int32_t pair, object, id;
+};
+
 // File codes of TriangleDistanceCase, fixed by the file format (not by the enum's order).
 std::uint8_t case_code(TriangleDistanceCase kind) {
   switch (kind) {
@@ -72,6 +89,10 @@ struct Hdf5ResultWriter::Impl {
   Handle string_type;
   Handle object_mem_type, object_file_type;
   Handle inter_mem_type, inter_file_type;
+  Handle pair_mem_type, pair_file_type;
+  Handle pd_mem_type, pd_file_type;
+  Handle vertex_feature_mem_type, vertex_feature_file_type;
+  Handle triangle_feature_mem_type, triangle_feature_file_type;
   Handle transfer;        ///< dataset transfer list, its buffer sized to each write
   Handle group_creation;  ///< keeps up to kCompactAttributes attributes in the object header
 
@@ -171,6 +192,77 @@ struct Hdf5ResultWriter::Impl {
          {"point_b", offsetof(InterRow, point_b), point_mem.get(), point_file.get()},
          {"case", offsetof(InterRow, kind), H5T_NATIVE_UINT8, H5T_STD_U8LE}},
         sizeof(InterRow), inter_mem_type, inter_file_type);
+    build_pd_types(point_mem.get(), point_file.get());
+  }
+
+  void build_pd_types(hid_t point_mem, hid_t point_file) {
+    auto i32 = [](const char* name, std::size_t offset) {
+      return Member{name, offset, H5T_NATIVE_INT32, H5T_STD_I32LE};
+    };
+    build_compound({i32("object_a", offsetof(PairRow, object_a)), i32("tri_a", offsetof(PairRow, tri_a)),
+                    i32("object_b", offsetof(PairRow, object_b)), i32("tri_b", offsetof(PairRow, tri_b))},
+                   sizeof(PairRow), pair_mem_type, pair_file_type);
+    build_compound({i32("object_a", offsetof(PdRow, object_a)), i32("object_b", offsetof(PdRow, object_b)),
+                    {"status", offsetof(PdRow, status), H5T_NATIVE_UINT8, H5T_STD_U8LE},
+                    {"depth", offsetof(PdRow, depth), H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE},
+                    {"direction", offsetof(PdRow, direction), point_mem, point_file},
+                    i32("deepest_object", offsetof(PdRow, deepest_object)),
+                    i32("deepest_vertex", offsetof(PdRow, deepest_vertex)),
+                    {"deepest_point", offsetof(PdRow, deepest_point), point_mem, point_file},
+                    {"nearest_point", offsetof(PdRow, nearest_point), point_mem, point_file}},
+                   sizeof(PdRow), pd_mem_type, pd_file_type);
+    build_compound({i32("pair", offsetof(FeatureRow, pair)), i32("object", offsetof(FeatureRow, object)),
+                    i32("vertex", offsetof(FeatureRow, id))},
+                   sizeof(FeatureRow), vertex_feature_mem_type, vertex_feature_file_type);
+    build_compound({i32("pair", offsetof(FeatureRow, pair)), i32("object", offsetof(FeatureRow, object)),
+                    i32("triangle", offsetof(FeatureRow, id))},
+                   sizeof(FeatureRow), triangle_feature_mem_type, triangle_feature_file_type);
+  }
+
+  void write_intersecting_pairs(hid_t group, const std::string& where,
+                                const std::vector<IntersectingPair>& pairs) const {
+    std::vector<PairRow> rows;
+    rows.reserve(pairs.size());
+    for (const IntersectingPair& p : pairs) rows.push_back({p.object_a, p.tri_a, p.object_b, p.tri_b});
+    write_dataset(group, where, "intersecting_pairs", pair_file_type.get(), pair_mem_type.get(),
+                  rows.size(), rows.data());
+  }
+
+  void write_pd(hid_t group, const std::string& where, const std::vector<PenetrationDepth>& pd) const {
+    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+    std::vector<PdRow> rows;
+    std::vector<FeatureRow> vertices, triangles;
+    for (std::size_t k = 0; k < pd.size(); ++k) {
+      const PenetrationDepth& p = pd[k];
+      const bool ok = p.status == PdStatus::Ok;
+      PdRow row{};
+      row.object_a = p.objects[0];
+      row.object_b = p.objects[1];
+      row.status = static_cast<std::uint8_t>(p.status);
+      row.depth = ok ? p.depth : kNaN;
+      row.deepest_object = ok ? p.deepest_object : kNoIndex;
+      row.deepest_vertex = ok ? p.deepest_vertex : kNoIndex;
+      const bool has_deepest = row.deepest_vertex != kNoIndex;
+      for (int c = 0; c < 3; ++c) {
+        row.direction[c] = ok ? p.direction[c] : kNaN;
+        row.deepest_point[c] = has_deepest ? p.deepest_point[c] : kNaN;
+        row.nearest_point[c] = has_deepest ? p.nearest_point[c] : kNaN;
+      }
+      rows.push_back(row);
+      const auto pair = static_cast<std::int32_t>(k);
+      for (std::size_t side = 0; side < 2; ++side) {
+        for (Index v : p.inside_vertices[side]) vertices.push_back({pair, p.objects[side], v});
+        for (Index t : p.overlapping_triangles[side]) triangles.push_back({pair, p.objects[side], t});
+      }
+    }
+    const std::string pd_where = where + "/pd";
+    Handle g = create_group(group, "pd", pd_where);
+    write_dataset(g.get(), pd_where, "pairs", pd_file_type.get(), pd_mem_type.get(), rows.size(), rows.data());
+    write_dataset(g.get(), pd_where, "inside_vertices", vertex_feature_file_type.get(),
+                  vertex_feature_mem_type.get(), vertices.size(), vertices.data());
+    write_dataset(g.get(), pd_where, "overlapping_triangles", triangle_feature_file_type.get(),
+                  triangle_feature_mem_type.get(), triangles.size(), triangles.data());
+    close_checked(g, "H5Gclose", pd_where);
   }
 
   void write_attribute(hid_t owner, const std::string& owner_name, const char* name,
@@ -323,6 +415,8 @@ struct Hdf5ResultWriter::Impl {
     write_attribute(s, stats_where, "pns_pairs", std::uint64_t{frame.counters.object_pns_pairs});
     write_attribute(s, stats_where, "feature_pns",
                     std::uint64_t{frame.counters.feature_pns});
+    if (frame.intersecting_pairs)
+      write_attribute(s, stats_where, "intersection_tests", std::uint64_t{frame.intersection_tests});
     if (frame.voronoi) {
       const VoronoiFrameStats& v = *frame.voronoi;
       for (int k = 0; k < 3; ++k) {
@@ -386,6 +480,8 @@ double Hdf5ResultWriter::write_frame(const FrameResult& frame,
   m.write_attribute(group.get(), where, "files", frame.files);
   m.write_objects(group.get(), where, frame);
   if (frame.inter) m.write_inter(group.get(), where, *frame.inter);
+  if (frame.intersecting_pairs) m.write_intersecting_pairs(group.get(), where, *frame.intersecting_pairs);
+  if (frame.pd) m.write_pd(group.get(), where, *frame.pd);
 
   const double write_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started)

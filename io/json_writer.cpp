@@ -33,6 +33,20 @@ Json inter_json(const InterObjectDistance& d) {
   return r;
 }
 
+Json pd_json(const PenetrationDepth& p) {
+  Json r;
+  r["objects"] = Json::array({p.objects[0], p.objects[1]});
+  if (p.status == PdStatus::Ok) {
+    r["depth"] = p.depth;
+    r["direction"] = point_json(p.direction);
+  } else {
+    r["depth"] = nullptr;
+    r["direction"] = nullptr;
+    r["status"] = pd_status_name(p.status);
+  }
+  return r;
+}
+
 // True when format_json spreads `value` over several lines.
 bool spreads(const Json& value) {
   if (value.is_array()) {
@@ -109,6 +123,13 @@ Json frame_json(const FrameResult& frame, double write_ms) {
     Json inter = Json::array();
     for (const InterObjectDistance& d : *frame.inter) inter.push_back(inter_json(d));
     j["distance"]["inter"] = std::move(inter);
+    if (frame.intersecting_pairs)
+      j["distance"]["intersecting_pairs"] = frame.intersecting_pairs->size();
+  }
+  if (frame.pd) {
+    Json pd = Json::array();
+    for (const PenetrationDepth& p : *frame.pd) pd.push_back(pd_json(p));
+    j["pd"] = std::move(pd);
   }
   const StageTimes& t = frame.time_ms;
   Json time_ms;
@@ -123,6 +144,7 @@ Json frame_json(const FrameResult& frame, double write_ms) {
   stats["exact_tests"] = frame.counters.exact_tests;
   stats["pns_pairs"] = frame.counters.object_pns_pairs;
   stats["feature_pns"] = frame.counters.feature_pns;
+  if (frame.intersecting_pairs) stats["intersection_tests"] = frame.intersection_tests;
   if (frame.voronoi) {
     const VoronoiFrameStats& v = *frame.voronoi;
     Json vj;

@@ -1,0 +1,155 @@
+#include "core/query/intersecting_pairs.hpp"
+
+#include "core/broad_phase/triangle_bvh.hpp"
+#include "core/geometry/triangle_distance.hpp"
+#include "core/mesh/adjacency.hpp"
+#include "core/parallel.hpp"
+#include "core/timer.hpp"
+#include "core/voronoi/stage2.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+namespace vproxq {
+namespace {
+
+/// Closed boxes overlap (touching included). Exact: a - b > 0 iff a > b for doubles.
+bool boxes_overlap(const AABB& a, const AABB& b) { return box_distance_squared(a, b) == 0.0; }
+
+/// Object pairs (i < j) whose boxes overlap, ascending: sweep and prune along x.
+std::vector<std::pair<Index, Index>> overlapping_objects(const FrameBoxes& boxes) {
+  const auto n = static_cast<Index>(boxes.objects.size());
+  std::vector<Index> order;
+  for (Index i = 0; i < n; ++i)
+    if (!boxes.objects[static_cast<size_t>(i)].empty()) order.push_back(i);
+  std::sort(order.begin(), order.end(), [&](Index a, Index b) {
+    const double la = boxes.objects[static_cast<size_t>(a)].lo.x();
+    const double lb = boxes.objects[static_cast<size_t>(b)].lo.x();
+    return la != lb ? la < lb : a < b;
+  });
+  std::vector<std::pair<Index, Index>> out;
+  for (size_t p = 0; p < order.size(); ++p) {
+    const AABB& a = boxes.objects[static_cast<size_t>(order[p])];
+    for (size_t q = p + 1; q < order.size(); ++q) {
+      const AABB& b = boxes.objects[static_cast<size_t>(order[q])];
+      if (b.lo.x() > a.hi.x()) break;  // sorted by lo.x: no later box reaches a either
+      if (boxes_overlap(a, b)) out.emplace_back(std::min(order[p], order[q]), std::max(order[p], order[q]));
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+/// A unit of work: triangles [first, last) of object i against object j (j == i: within i).
+struct WorkItem {
+  Index i, j, first, last;
+};
+
+constexpr Index kChunk = 256;  // triangles per work item: enough items to balance threads
+
+}  // namespace
+
+IntersectingPairsOutput intersecting_pairs(const Frame& frame, const IntersectingPairsOptions& opts) {
+  const FrameBoxes boxes = FrameBoxes::compute(frame, std::max(1, opts.threads));
+  return intersecting_pairs(frame, boxes, opts);
+}
+
+IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes& boxes,
+                                           const IntersectingPairsOptions& opts) {
+  Stopwatch sw;
+  IntersectingPairsOutput out;
+  const int threads = std::max(1, opts.threads);
+  const size_t n = frame.objects.size();
+
+  std::vector<WorkItem> items;
+  auto add_chunks = [&](Index i, Index j) {
+    const Index nt = frame.objects[static_cast<size_t>(i)].num_triangles();
+    for (Index f = 0; f < nt; f += kChunk) items.push_back({i, j, f, std::min(nt, f + kChunk)});
+  };
+  const auto object_pairs = overlapping_objects(boxes);
+  std::vector<char> needs_bvh(n, 0);
+  for (const auto& [i, j] : object_pairs) {
+    add_chunks(i, j);
+    needs_bvh[static_cast<size_t>(j)] = 1;
+  }
+  if (opts.intra) {
+    for (size_t i = 0; i < n; ++i) {
+      add_chunks(static_cast<Index>(i), static_cast<Index>(i));
+      needs_bvh[i] = 1;
+    }
+  }
+  std::vector<TriangleBvh> bvhs(n);
+  parallel_for(n, threads, [&](size_t i) {
+    if (needs_bvh[i]) bvhs[i].build(boxes.triangles[i]);
+  });
+
+  const VoronoiBounds* voronoi = opts.voronoi;
+  std::vector<std::vector<IntersectingPair>> found(items.size());
+  std::vector<std::uint64_t> tests(items.size(), 0);
+  const auto zero = [] { return 0.0; };  // box overlap only
+  parallel_for(items.size(), threads, [&](size_t k) {
+    const WorkItem& w = items[k];
+    const Object& oi = frame.objects[static_cast<size_t>(w.i)];
+    const Object& oj = frame.objects[static_cast<size_t>(w.j)];
+    const auto& tb_i = boxes.triangles[static_cast<size_t>(w.i)];
+    auto& hits = found[k];
+    if (w.i == w.j) {
+      for (Index f = w.first; f < w.last; ++f) {
+        const Face& ff = oi.topology->faces[static_cast<size_t>(f)];
+        bvhs[static_cast<size_t>(w.i)].query(tb_i[static_cast<size_t>(f)], zero, [&](Index g, double) {
+          if (g <= f || Adjacency::share_vertex(ff, oi.topology->faces[static_cast<size_t>(g)])) return;
+          ++tests[k];
+          if (triangles_intersect(oi.triangle(f), oi.triangle(g))) hits.push_back({w.i, f, w.i, g});
+        });
+      }
+    } else {
+      // D_l(f) > 0: f is at positive distance from every other object (Lemma 2), so it
+      // touches none; only exact zeros intersect, so the comparison is with 0, no slack.
+      const double* low_i = voronoi ? voronoi->triangle_lower[static_cast<size_t>(w.i)].data() : nullptr;
+      const double* low_j = voronoi ? voronoi->triangle_lower[static_cast<size_t>(w.j)].data() : nullptr;
+      const AABB& box_j = boxes.objects[static_cast<size_t>(w.j)];
+      for (Index f = w.first; f < w.last; ++f) {
+        if (low_i && low_i[f] > 0.0) continue;
+        const AABB& bf = tb_i[static_cast<size_t>(f)];
+        if (!boxes_overlap(bf, box_j)) continue;
+        bvhs[static_cast<size_t>(w.j)].query(bf, zero, [&](Index g, double) {
+          if (low_j && low_j[g] > 0.0) return;
+          ++tests[k];
+          if (triangles_intersect(oi.triangle(f), oj.triangle(g))) hits.push_back({w.i, f, w.j, g});
+        });
+      }
+    }
+    std::sort(hits.begin(), hits.end());
+  });
+  for (size_t k = 0; k < items.size(); ++k) {
+    out.pairs.insert(out.pairs.end(), found[k].begin(), found[k].end());
+    out.exact_tests += tests[k];
+  }
+  // Items are already in canonical order except that intra items follow the inter ones.
+  std::sort(out.pairs.begin(), out.pairs.end());
+  out.ms = sw.elapsed_ms();
+  return out;
+}
+
+IntersectingPairsOutput intersecting_pairs_brute_force(const Frame& frame, bool intra) {
+  IntersectingPairsOutput out;
+  const auto n = static_cast<Index>(frame.objects.size());
+  for (Index i = 0; i < n; ++i) {
+    const Object& oi = frame.objects[static_cast<size_t>(i)];
+    for (Index j = intra ? i : i + 1; j < n; ++j) {
+      const Object& oj = frame.objects[static_cast<size_t>(j)];
+      for (Index f = 0; f < oi.num_triangles(); ++f)
+        for (Index g = (i == j ? f + 1 : 0); g < oj.num_triangles(); ++g) {
+          if (i == j && Adjacency::share_vertex(oi.topology->faces[static_cast<size_t>(f)],
+                                                oj.topology->faces[static_cast<size_t>(g)]))
+            continue;
+          ++out.exact_tests;
+          if (triangles_intersect(oi.triangle(f), oj.triangle(g))) out.pairs.push_back({i, f, j, g});
+        }
+    }
+  }
+  std::sort(out.pairs.begin(), out.pairs.end());
+  return out;
+}
+
+}  // namespace vproxq

@@ -1,0 +1,145 @@
+// Discrete collisions and penetration depth end to end: the two-cubes meshes (split into
+// objects by connected component) and the CLI's JSON and HDF5 output against the brute force.
+#include "core/query/intersecting_pairs.hpp"
+#include "core/query/penetration_depth.hpp"
+#include "io/hdf5_reader.hpp"
+#include "io/mesh_reader.hpp"
+#include "io/scene_source.hpp"
+#include "support/process.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+
+namespace vproxq {
+namespace {
+
+namespace fs = std::filesystem;
+using test::quote;
+using test::run_command;
+using test::ScratchDir;
+
+const fs::path kMeshes = fs::path(VPROXQ_TEST_DATA_DIR) / "meshes";
+const char* const kTwoCubes[] = {"two-cubes-far.ply", "two-cubes-close.ply", "two-cubes-intersecting.ply"};
+
+/// One frame with one object per connected component of the file.
+Frame load_components(const fs::path& file) {
+  Frame frame;
+  for (const MeshGroup& g : read_mesh_file(file))
+    for (MeshGroup& c : split_components(g)) {
+      Object o;
+      o.name = c.name;
+      auto topo = std::make_shared<Topology>();
+      topo->num_vertices = static_cast<Index>(c.positions.size());
+      topo->faces = std::move(c.faces);
+      o.topology = topo;
+      o.positions = std::move(c.positions);
+      frame.objects.push_back(std::move(o));
+    }
+  return frame;
+}
+
+TEST(PdTwoCubes, IntersectingHasDepthCloseAndFarHaveNoPairs) {
+  for (const char* name : kTwoCubes) {
+    SCOPED_TRACE(name);
+    const Frame frame = load_components(kMeshes / name);
+    ASSERT_EQ(frame.objects.size(), 2u);
+    const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
+    const auto got = intersecting_pairs(frame, boxes, {2, nullptr, true});
+    const auto ref = intersecting_pairs_brute_force(frame);
+    EXPECT_EQ(got.pairs, ref.pairs);
+    const auto pd = penetration_depth(frame, boxes, got.pairs, {2}).pairs;
+    if (std::string(name) == "two-cubes-intersecting.ply") {
+      ASSERT_FALSE(got.pairs.empty());
+      ASSERT_EQ(pd.size(), 1u);
+      EXPECT_EQ(pd[0].status, PdStatus::Ok) << pd_status_name(pd[0].status);
+      EXPECT_GT(pd[0].depth, 0.0);
+      EXPECT_NEAR(pd[0].direction.norm(), 1.0, 1e-12);
+      std::printf("[ two-cubes ] %zu intersecting pairs, depth %.17g, direction (%.6g, %.6g, %.6g)\n",
+                  got.pairs.size(), pd[0].depth, pd[0].direction.x(), pd[0].direction.y(), pd[0].direction.z());
+    } else {
+      EXPECT_TRUE(got.pairs.empty());
+      EXPECT_TRUE(pd.empty());
+    }
+  }
+}
+
+TEST(PdTwoCubes, CliWritesPairsAndDepth) {
+  ScratchDir dir;
+  for (const char* name : kTwoCubes) fs::copy_file(kMeshes / name, dir / name);
+  const auto scene = dir.write("scene.json", R"({"name": "two-cubes", "objects": "components",
+    "frames": {"files": ["two-cubes-far.ply", "two-cubes-close.ply", "two-cubes-intersecting.ply"]}})");
+  const auto r = run_command(std::string(VPROXQ_BINARY) + " " + quote(scene) +
+                             " --queries=distance,pd --threads 2 --quiet -o " + quote(dir / "out"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(dir / "out" / "results.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["queries"], nlohmann::json::array({"distance", "pd"}));
+  const SceneSource source = SceneSource::open(scene);
+  Hdf5Reader h5(dir / "out" / "results.h5");
+  ASSERT_EQ(j["frames"].size(), 3u);
+  for (size_t k = 0; k < 3; ++k) {
+    SCOPED_TRACE("frame " + std::to_string(k));
+    const Frame frame = source.load_frame(k);
+    const auto ref = intersecting_pairs_brute_force(frame);
+    const auto& fj = j["frames"][k];
+    EXPECT_EQ(fj["distance"]["intersecting_pairs"].get<size_t>(), ref.pairs.size());
+    const std::string group = "/frames/00000" + std::to_string(k);
+    const std::string ds = group + "/intersecting_pairs";
+    ASSERT_EQ(h5.rows(ds), ref.pairs.size());
+    const auto oa = h5.int_field(ds, "object_a"), ta = h5.int_field(ds, "tri_a");
+    const auto ob = h5.int_field(ds, "object_b"), tb = h5.int_field(ds, "tri_b");
+    for (size_t p = 0; p < ref.pairs.size(); ++p)
+      EXPECT_EQ((IntersectingPair{static_cast<Index>(oa[p]), static_cast<Index>(ta[p]),
+                                  static_cast<Index>(ob[p]), static_cast<Index>(tb[p])}),
+                ref.pairs[p]);
+    const auto pd = penetration_depth(frame, FrameBoxes::compute(frame, 1), ref.pairs, {1}).pairs;
+    ASSERT_EQ(fj["pd"].size(), pd.size());
+    ASSERT_EQ(h5.rows(group + "/pd/pairs"), pd.size());
+    for (size_t p = 0; p < pd.size(); ++p) {
+      EXPECT_EQ(fj["pd"][p]["objects"], nlohmann::json::array({pd[p].objects[0], pd[p].objects[1]}));
+      ASSERT_EQ(pd[p].status, PdStatus::Ok);
+      EXPECT_FALSE(fj["pd"][p].contains("status"));
+      EXPECT_EQ(fj["pd"][p]["depth"].get<double>(), pd[p].depth);
+      EXPECT_GT(pd[p].depth, 0.0);
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(fj["pd"][p]["direction"][c].get<double>(), pd[p].direction[c]);
+      EXPECT_EQ(h5.double_field(group + "/pd/pairs", "depth")[p], pd[p].depth);
+      EXPECT_EQ(h5.int_field(group + "/pd/pairs", "status")[p], 0);
+      const auto verts = h5.int_field(group + "/pd/inside_vertices", "vertex");
+      EXPECT_EQ(verts.size(), pd[p].inside_vertices[0].size() + pd[p].inside_vertices[1].size());
+    }
+  }
+}
+
+TEST(PdTwoCubes, CliReportsStatusInsteadOfNumber) {
+  // An open surface (one face of the second box missing) intersecting a box: status, nulls.
+  ScratchDir dir;
+  std::string obj;
+  auto box = [&](double x0, int base, bool drop_last) {
+    for (int k = 0; k < 8; ++k)
+      obj += "v " + std::to_string(x0 + (k & 1)) + " " + std::to_string((k >> 1) & 1) + " " + std::to_string((k >> 2) & 1) + "\n";
+    const int q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    for (int f = 0; f < (drop_last ? 5 : 6); ++f)
+      obj += "f " + std::to_string(base + q[f][0]) + " " + std::to_string(base + q[f][1]) + " " +
+             std::to_string(base + q[f][2]) + " " + std::to_string(base + q[f][3]) + "\n";
+  };
+  obj += "o closed\n";
+  box(0.0, 1, false);
+  obj += "o open\n";
+  box(0.5, 9, true);
+  const auto file = dir.write("boxes.obj", obj);
+  const auto r = run_command(std::string(VPROXQ_BINARY) + " " + quote(file) + " --queries=pd --quiet -o " + quote(dir / "out"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(dir / "out" / "results.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  const auto& fj = j["frames"][0];
+  EXPECT_FALSE(fj.contains("distance"));
+  ASSERT_EQ(fj["pd"].size(), 1u);
+  EXPECT_EQ(fj["pd"][0]["status"], "open_surface");
+  EXPECT_TRUE(fj["pd"][0]["depth"].is_null());
+  EXPECT_TRUE(fj["pd"][0]["direction"].is_null());
+}
+
+}  // namespace
+}  // namespace vproxq

@@ -1,0 +1,116 @@
+// Discrete collisions: the list of intersecting triangle pairs equals the all-pairs brute
+// force (exact triangle–triangle intersection) with and without Stage II bounds, for any
+// thread count.
+#include "core/mesh/adjacency.hpp"
+#include "core/query/intersecting_pairs.hpp"
+#include "core/voronoi/stage2.hpp"
+#include "support/random_scene.hpp"
+
+#include <gtest/gtest.h>
+
+namespace vproxq {
+namespace {
+
+using test::make_random_frame;
+using test::make_soup;
+using test::Rng;
+
+size_t count_intra(const std::vector<IntersectingPair>& pairs) {
+  size_t n = 0;
+  for (const auto& p : pairs) n += p.object_a == p.object_b;
+  return n;
+}
+
+/// Overlapping blobs (inter pairs) plus triangle soups (many intra pairs, no shared vertices).
+Frame mixed_frame(std::uint64_t seed) {
+  Frame frame = make_random_frame(seed, 2 + static_cast<int>(seed % 7), 1.0 + 0.4 * static_cast<double>(seed % 4), 1);
+  Rng rng(seed * 77);
+  for (int k = 0; k < 2; ++k)
+    frame.objects.push_back(make_soup(rng, Vec3(rng.uniform(0, 2), rng.uniform(0, 2), rng.uniform(0, 2)),
+                                      0.5, 0.3, 25, "soup" + std::to_string(k)));
+  return frame;
+}
+
+TEST(IntersectingPairs, RandomScenesEqualBruteForce) {
+  size_t total_inter = 0, total_intra = 0;
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    const Frame frame = mixed_frame(seed);
+    const auto ref = intersecting_pairs_brute_force(frame);
+    total_intra += count_intra(ref.pairs);
+    total_inter += ref.pairs.size() - count_intra(ref.pairs);
+    for (int threads : {1, 3}) {
+      SCOPED_TRACE("seed " + std::to_string(seed) + " threads " + std::to_string(threads));
+      const auto got = intersecting_pairs(frame, {threads, nullptr, true});
+      EXPECT_EQ(got.pairs, ref.pairs);
+      EXPECT_LE(got.exact_tests, ref.exact_tests);
+    }
+    // Without intra pairs: exactly the inter-object part of the list.
+    std::vector<IntersectingPair> inter_only;
+    for (const auto& p : ref.pairs)
+      if (p.object_a != p.object_b) inter_only.push_back(p);
+    EXPECT_EQ(intersecting_pairs(frame, {2, nullptr, false}).pairs, inter_only);
+    EXPECT_EQ(intersecting_pairs_brute_force(frame, false).pairs, inter_only);
+  }
+  // The scenes must exercise both kinds, or the comparison proves little.
+  EXPECT_GT(total_inter, 50u);
+  EXPECT_GT(total_intra, 50u);
+}
+
+TEST(IntersectingPairs, CanonicalOrder) {
+  const Frame frame = mixed_frame(4);
+  const auto got = intersecting_pairs(frame, {2, nullptr, true});
+  ASSERT_FALSE(got.pairs.empty());
+  for (size_t k = 0; k < got.pairs.size(); ++k) {
+    const auto& p = got.pairs[k];
+    EXPECT_LE(p.object_a, p.object_b);
+    if (p.object_a == p.object_b) {
+      EXPECT_LT(p.tri_a, p.tri_b);
+      EXPECT_FALSE(Adjacency::share_vertex(frame.objects[static_cast<size_t>(p.object_a)].topology->faces[static_cast<size_t>(p.tri_a)],
+                                           frame.objects[static_cast<size_t>(p.object_a)].topology->faces[static_cast<size_t>(p.tri_b)]));
+    }
+    if (k > 0) {
+      EXPECT_TRUE(got.pairs[k - 1] < p);
+    }
+  }
+}
+
+TEST(IntersectingPairs, WithCpuVoronoiBoundsEqualBruteForce) {
+  auto backend = make_cpu_voronoi_backend(2);
+  for (std::uint64_t seed = 11; seed <= 16; ++seed) {
+    const Frame frame = mixed_frame(seed);
+    const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
+    const ObjectBroadPhase stage1 = object_broad_phase(frame, boxes, 2);
+    const auto ref = intersecting_pairs_brute_force(frame);
+    for (int grid : {16, 48}) {
+      SCOPED_TRACE("seed " + std::to_string(seed) + " grid " + std::to_string(grid));
+      const VoronoiBounds vb = compute_voronoi_bounds(frame, boxes, stage1, *backend, grid, 2);
+      const auto got = intersecting_pairs(frame, boxes, {2, &vb, true});
+      EXPECT_EQ(got.pairs, ref.pairs);
+    }
+  }
+}
+
+TEST(IntersectingPairs, SeparatedAndTouchingObjects) {
+  // Two single triangles: apart, then sharing exactly one point (touching counts).
+  auto tri_object = [](const Triangle& t, const std::string& name) {
+    auto topo = std::make_shared<Topology>();
+    topo->num_vertices = 3;
+    topo->faces = {Face{0, 1, 2}};
+    Object o;
+    o.name = name;
+    o.topology = topo;
+    o.positions = {t[0], t[1], t[2]};
+    return o;
+  };
+  Frame frame;
+  frame.objects.push_back(tri_object({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)}, "a"));
+  frame.objects.push_back(tri_object({Vec3(0.25, 0.25, 1e-12), Vec3(1, 1, 1), Vec3(0, 1, 1)}, "b"));
+  EXPECT_TRUE(intersecting_pairs(frame, {1}).pairs.empty());
+  frame.objects[1].positions[0].z() = 0;  // vertex of b on the interior of a
+  const auto got = intersecting_pairs(frame, {1});
+  ASSERT_EQ(got.pairs.size(), 1u);
+  EXPECT_EQ(got.pairs[0], (IntersectingPair{0, 0, 1, 0}));
+}
+
+}  // namespace
+}  // namespace vproxq

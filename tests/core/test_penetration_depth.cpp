@@ -1,0 +1,469 @@
+// Local penetration depth (paper 3.3) against analytic truth: overlapping axis-aligned boxes
+// (depth d along the overlap axis), overlapping icospheres (depth within the stated sampling
+// error of r1 + r2 - |c1 - c2|), the exact inside test, and the statuses where PD is undefined.
+#include "core/query/intersecting_pairs.hpp"
+#include "core/geometry/point_triangle.hpp"
+#include "core/mesh/adjacency.hpp"
+#include "core/query/penetration_depth.hpp"
+#include "support/random_scene.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+namespace vproxq {
+namespace {
+
+/// The box [lo, lo + size] with every face cut into an n x n grid of quads (2 triangles
+/// each), vertices shared along the box's edges: closed, faces oriented outwards.
+Object make_box(const Vec3& lo, const Vec3& size, int n, const std::string& name) {
+  std::map<std::array<int, 3>, Index> ids;
+  Object o;
+  auto topo = std::make_shared<Topology>();
+  auto vertex = [&](std::array<int, 3> g) {
+    auto it = ids.find(g);
+    if (it != ids.end()) return it->second;
+    const Index id = static_cast<Index>(o.positions.size());
+    Vec3 p;
+    for (int k = 0; k < 3; ++k) p[k] = lo[k] + size[k] * (static_cast<double>(g[static_cast<size_t>(k)]) / n);
+    o.positions.push_back(p);
+    ids[g] = id;
+    return id;
+  };
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;  // e_u x e_v = e_axis
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+          auto corner = [&](int di, int dj) {
+            std::array<int, 3> g{};
+            g[static_cast<size_t>(axis)] = side * n;
+            g[static_cast<size_t>(u)] = i + di;
+            g[static_cast<size_t>(v)] = j + dj;
+            return vertex(g);
+          };
+          const Index a = corner(0, 0), b = corner(1, 0), c = corner(1, 1), d = corner(0, 1);
+          if (side == 1) {  // counter-clockwise in (u, v): normal +axis
+            topo->faces.push_back({a, b, c});
+            topo->faces.push_back({a, c, d});
+          } else {
+            topo->faces.push_back({a, c, b});
+            topo->faces.push_back({a, d, c});
+          }
+        }
+    }
+  topo->num_vertices = static_cast<Index>(o.positions.size());
+  o.topology = topo;
+  o.name = name;
+  return o;
+}
+
+/// An icosahedron subdivided `levels` times (midpoints pushed onto the sphere): 20 * 4^levels
+/// triangles, every vertex on the sphere of radius r around c, faces oriented outwards.
+Object make_icosphere(const Vec3& c, double r, int levels, const std::string& name) {
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<Vec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                         {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  for (Vec3& p : v) p.normalize();
+  std::vector<Face> f = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11},
+                         {1, 5, 9}, {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                         {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8}, {3, 8, 9},
+                         {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+  for (int l = 0; l < levels; ++l) {
+    std::map<std::pair<Index, Index>, Index> mid;
+    auto midpoint = [&](Index a, Index b) {
+      const auto key = std::minmax(a, b);
+      auto it = mid.find({key.first, key.second});
+      if (it != mid.end()) return it->second;
+      v.push_back((v[static_cast<size_t>(a)] + v[static_cast<size_t>(b)]).normalized());
+      const Index id = static_cast<Index>(v.size() - 1);
+      mid[{key.first, key.second}] = id;
+      return id;
+    };
+    std::vector<Face> nf;
+    for (const Face& q : f) {
+      const Index a = midpoint(q[0], q[1]), b = midpoint(q[1], q[2]), cc = midpoint(q[2], q[0]);
+      nf.push_back({q[0], a, cc});
+      nf.push_back({q[1], b, a});
+      nf.push_back({q[2], cc, b});
+      nf.push_back({a, b, cc});
+    }
+    f = std::move(nf);
+  }
+  Object o;
+  auto topo = std::make_shared<Topology>();
+  topo->num_vertices = static_cast<Index>(v.size());
+  topo->faces = f;
+  o.topology = topo;
+  o.name = name;
+  for (const Vec3& p : v) o.positions.push_back(c + r * p);
+  return o;
+}
+
+Frame frame_of(std::vector<Object> objects) {
+  Frame frame;
+  frame.objects = std::move(objects);
+  return frame;
+}
+
+std::vector<PenetrationDepth> run_pd(const Frame& frame, int threads = 2) {
+  const FrameBoxes boxes = FrameBoxes::compute(frame, threads);
+  const auto pairs = intersecting_pairs(frame, boxes, {threads, nullptr, true});
+  return penetration_depth(frame, boxes, pairs.pairs, {threads}).pairs;
+}
+
+Vec3 axis_vector(int axis, double s = 1.0) {
+  Vec3 e = Vec3::Zero();
+  e[axis] = s;
+  return e;
+}
+
+TEST(PenetrationDepth, WindingNumberIsExactOnDegenerateRays) {
+  // Rays from points on the grid lines of a subdivided box pass exactly through its vertices
+  // and edges: the perturbed count must still be 1 inside, 0 outside, and points on a face
+  // not parallel to the ray are reported on the surface.
+  const Object box = make_box(Vec3(0, 0, 0), Vec3(1, 1, 1), 4, "box");
+  Object flipped = box;
+  auto topo = std::make_shared<Topology>(*box.topology);
+  for (Face& f : topo->faces) std::swap(f[1], f[2]);
+  flipped.topology = topo;
+  int inside = 0, outside = 0, on = 0;
+  for (int i = -2; i <= 10; ++i)
+    for (int j = -2; j <= 10; ++j)
+      for (int k = -2; k <= 10; ++k) {
+        const Vec3 p(0.125 * i, 0.125 * j, 0.125 * k);
+        bool on_surface = false;
+        const int w = winding_number_brute_force(p, box, on_surface);
+        bool on_flipped = false;
+        const int wf = winding_number_brute_force(p, flipped, on_flipped);
+        EXPECT_EQ(on_surface, on_flipped);
+        auto strictly = [](double x) { return x > 0 && x < 1; };
+        auto closed = [](double x) { return x >= 0 && x <= 1; };
+        const bool in_open = strictly(p.x()) && strictly(p.y()) && strictly(p.z());
+        const bool in_closed = closed(p.x()) && closed(p.y()) && closed(p.z());
+        SCOPED_TRACE("p = " + std::to_string(p.x()) + "," + std::to_string(p.y()) + "," + std::to_string(p.z()));
+        if (in_open) {
+          EXPECT_FALSE(on_surface);
+          EXPECT_EQ(w, 1);
+          EXPECT_EQ(wf, -1);
+          ++inside;
+        } else if (!in_closed) {
+          EXPECT_FALSE(on_surface);
+          EXPECT_EQ(w, 0);
+          EXPECT_EQ(wf, 0);
+          ++outside;
+        } else {
+          // On the boundary. The faces x = 0 and x = 1 cross the ray: p is reported on the
+          // surface when the perturbed point p' = p + (0, e, e^2) projects into them, i.e.
+          // y, z in [0, 1). Otherwise the count is the winding number around p', which is
+          // inside iff x in (0, 1) and y, z in [0, 1).
+          const bool yz = p.y() >= 0 && p.y() < 1 && p.z() >= 0 && p.z() < 1;
+          const bool expect_on = (p.x() == 0 || p.x() == 1) && yz;
+          EXPECT_EQ(on_surface, expect_on);
+          if (on_surface) {
+            ++on;
+          } else {
+            EXPECT_EQ(w, strictly(p.x()) && yz ? 1 : 0);
+            EXPECT_EQ(wf, -w);
+          }
+        }
+      }
+  EXPECT_GT(inside, 300);
+  EXPECT_GT(outside, 1000);
+  EXPECT_GT(on, 100);
+}
+
+TEST(PenetrationDepth, OverlappingBoxesGiveDepthDAlongTheAxis) {
+  // Unit boxes [0,1]^3 and [0,1]^3 + (1-d) e_axis: faces lying on each other, vertices on
+  // the other's faces and edges. The overlap is d thick along the axis; A must move -axis.
+  for (int n : {1, 4}) {
+    for (int axis = 0; axis < 3; ++axis)
+      for (double d : {0.1, 0.3, 0.45}) {
+        SCOPED_TRACE("n " + std::to_string(n) + " axis " + std::to_string(axis) + " d " + std::to_string(d));
+        const Frame frame = frame_of({make_box(Vec3::Zero(), Vec3::Ones(), n, "a"),
+                                      make_box(axis_vector(axis, 1 - d), Vec3::Ones(), n, "b")});
+        const auto pd = run_pd(frame);
+        ASSERT_EQ(pd.size(), 1u);
+        EXPECT_EQ(pd[0].status, PdStatus::Ok) << pd_status_name(pd[0].status);
+        EXPECT_LE(std::abs(pd[0].depth - d), 1e-9 * d) << "depth " << pd[0].depth;
+        EXPECT_LE((pd[0].direction - axis_vector(axis, -1)).norm(), 1e-12);
+        // Every vertex strictly inside the other box is listed, and only those or vertices
+        // on its boundary.
+        for (int side = 0; side < 2; ++side) {
+          const Object& own = frame.objects[static_cast<size_t>(side)];
+          const Object& other = frame.objects[static_cast<size_t>(1 - side)];
+          Vec3 olo = Vec3::Constant(kInfinity), ohi = Vec3::Constant(-kInfinity);
+          for (const Vec3& p : other.positions) {
+            olo = olo.cwiseMin(p);
+            ohi = ohi.cwiseMax(p);
+          }
+          const auto& list = pd[0].inside_vertices[static_cast<size_t>(side)];
+          for (Index v = 0; v < own.num_vertices(); ++v) {
+            const Vec3& p = own.positions[static_cast<size_t>(v)];
+            const bool strictly = (p.array() > olo.array()).all() && (p.array() < ohi.array()).all();
+            const bool closed = (p.array() >= olo.array()).all() && (p.array() <= ohi.array()).all();
+            const bool listed = std::binary_search(list.begin(), list.end(), v);
+            if (strictly) {
+              EXPECT_TRUE(listed) << "side " << side << " vertex " << v;
+            }
+            if (listed) {
+              EXPECT_TRUE(closed) << "side " << side << " vertex " << v;
+            }
+          }
+        }
+      }
+  }
+}
+
+TEST(PenetrationDepth, OffsetBoxesUseTheDeepestVertex) {
+  // 12-triangle boxes offset sideways too: corner (1,1,1) of A is inside B, d from B's
+  // face x = 1-d and farther from its other faces when d < 0.4.
+  for (int axis = 0; axis < 3; ++axis)
+    for (double d : {0.05, 0.2, 0.35}) {
+      SCOPED_TRACE("axis " + std::to_string(axis) + " d " + std::to_string(d));
+      Vec3 offset = axis_vector(axis, 1 - d) + axis_vector((axis + 1) % 3, 0.5) + axis_vector((axis + 2) % 3, 0.4);
+      const Frame frame = frame_of({make_box(Vec3::Zero(), Vec3::Ones(), 1, "a"),
+                                    make_box(offset, Vec3::Ones(), 1, "b")});
+      const auto pd = run_pd(frame);
+      ASSERT_EQ(pd.size(), 1u);
+      ASSERT_EQ(pd[0].status, PdStatus::Ok) << pd_status_name(pd[0].status);
+      EXPECT_LE(std::abs(pd[0].depth - d), 1e-9 * d) << "depth " << pd[0].depth;
+      EXPECT_LE((pd[0].direction - axis_vector(axis, -1)).norm(), 1e-12);
+      EXPECT_EQ(pd[0].inside_vertices[0].size(), 1u);  // corner (1,1,1) of A
+      EXPECT_EQ(pd[0].inside_vertices[1].size(), 1u);  // the opposite corner of B
+      EXPECT_NE(pd[0].deepest_vertex, kNoIndex);
+    }
+}
+
+/// Width along unit u of the lens B(c1, r1) ∩ B(c2, r2): support function in u and -u. The
+/// extreme point in direction u is the ball point c + r u of one ball if it lies in the other
+/// ball, else a point of the rim circle (where the spheres meet).
+double lens_width(const Vec3& c1, double r1, const Vec3& c2, double r2, const Vec3& u) {
+  const Vec3 axis = (c2 - c1).normalized();
+  const double dist = (c2 - c1).norm();
+  const double x = (dist * dist + r1 * r1 - r2 * r2) / (2 * dist);  // rim plane from c1
+  const Vec3 m = c1 + x * axis;
+  const double a = std::sqrt(r1 * r1 - x * x);  // rim radius
+  auto support = [&](const Vec3& w) {
+    const Vec3 p1 = c1 + r1 * w, p2 = c2 + r2 * w;
+    double h = -kInfinity;
+    if ((p1 - c2).norm() <= r2) h = std::max(h, p1.dot(w));
+    if ((p2 - c1).norm() <= r1) h = std::max(h, p2.dot(w));
+    const Vec3 lateral = w - w.dot(axis) * axis;
+    h = std::max(h, m.dot(w) + a * lateral.norm());
+    return h;
+  };
+  return support(u) + support(-u);
+}
+
+/// Smallest distance from c to the mesh surface: the mesh lies between the spheres of this
+/// radius and of r (every vertex is on the sphere of radius r; the mesh is convex).
+double inner_radius(const Object& o, const Vec3& c) {
+  double best = kInfinity;
+  for (Index t = 0; t < o.num_triangles(); ++t)
+    best = std::min(best, std::sqrt(point_triangle_distance(c, o.triangle(t)).squared_distance));
+  return best;
+}
+
+TEST(PenetrationDepth, IcospheresWithinSamplingError) {
+  // Each icosphere (1280 triangles) is a convex polyhedron P_k with B(c_k, ri_k) ⊂ P_k ⊂
+  // B(c_k, r_k). The computed depth is the width of P_1 ∩ P_2 along T, so it lies between the
+  // width of the inner lens along T (>= its thickness ri1 + ri2 - D: the axis is the lens's
+  // narrowest direction) and the width of the outer lens along T. Hence the stated sampling
+  // error: |depth - (r1 + r2 - D)| <= max((r1 - ri1) + (r2 - ri2), W_outer(T) - (r1 + r2 - D)).
+  struct Case {
+    Vec3 c2;
+    double r2;
+  };
+  const double r1 = 1.0;
+  const Vec3 c1(0.1, -0.2, 0.3);
+  for (const Case& k : {Case{Vec3(1.6, 0.3, 0.1), 0.9}, Case{Vec3(-0.4, 1.2, 1.3), 1.1},
+                        Case{Vec3(0.3, -1.5, 0.9), 0.8}}) {
+    const Frame frame = frame_of({make_icosphere(c1, r1, 3, "s1"), make_icosphere(k.c2, k.r2, 3, "s2")});
+    ASSERT_EQ(frame.objects[0].num_triangles(), 1280);
+    const double dist = (k.c2 - c1).norm();
+    const double exact = r1 + k.r2 - dist;
+    const double ri1 = inner_radius(frame.objects[0], c1), ri2 = inner_radius(frame.objects[1], k.c2);
+    const auto pd = run_pd(frame);
+    ASSERT_EQ(pd.size(), 1u);
+    ASSERT_EQ(pd[0].status, PdStatus::Ok) << pd_status_name(pd[0].status);
+    const Vec3 axis = (k.c2 - c1).normalized();
+    const double outer = lens_width(c1, r1, k.c2, k.r2, pd[0].direction);
+    const double bound = std::max((r1 - ri1) + (k.r2 - ri2), outer - exact);
+    const double angle = std::acos(std::min(1.0, -pd[0].direction.dot(axis)));
+    std::printf("[ icospheres ] exact %.6f depth %.6f error %.2e bound %.2e (ri: %.5f %.5f) "
+                "angle(T, -axis) %.4f rad, inside %zu + %zu vertices\n",
+                exact, pd[0].depth, pd[0].depth - exact, bound, ri1, ri2, angle,
+                pd[0].inside_vertices[0].size(), pd[0].inside_vertices[1].size());
+    EXPECT_GE(pd[0].depth, ri1 + ri2 - dist - 1e-12);
+    EXPECT_LE(pd[0].depth, outer + 1e-12);
+    EXPECT_LE(std::abs(pd[0].depth - exact), bound);
+    EXPECT_LT(angle, 0.5);  // T points from sphere 2 towards sphere 1 (A moves away from B)
+    // Inside vertices agree with the balls wherever the balls decide.
+    for (int side = 0; side < 2; ++side) {
+      const Object& own = frame.objects[static_cast<size_t>(side)];
+      const Vec3 oc = side == 0 ? k.c2 : c1;
+      const double orad = side == 0 ? k.r2 : r1, oin = side == 0 ? ri2 : ri1;
+      const auto& list = pd[0].inside_vertices[static_cast<size_t>(side)];
+      for (Index v = 0; v < own.num_vertices(); ++v) {
+        const double dv = (own.positions[static_cast<size_t>(v)] - oc).norm();
+        const bool listed = std::binary_search(list.begin(), list.end(), v);
+        if (dv < oin) {
+          EXPECT_TRUE(listed) << "vertex " << v << " deep inside";
+        }
+        if (dv > orad) {
+          EXPECT_FALSE(listed) << "vertex " << v << " outside the ball";
+        }
+      }
+    }
+  }
+}
+
+TEST(PenetrationDepth, ThreadCountDoesNotChangeResults) {
+  const Frame frame = frame_of({make_icosphere(Vec3::Zero(), 1.0, 2, "s1"), make_icosphere(Vec3(1.5, 0.2, 0), 0.8, 2, "s2"),
+                                make_box(Vec3(0.5, -0.3, -0.2), Vec3(1.2, 0.5, 0.4), 3, "box")});
+  const auto a = run_pd(frame, 1), b = run_pd(frame, 3);
+  ASSERT_EQ(a.size(), 3u);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].objects, b[k].objects);
+    EXPECT_EQ(a[k].status, b[k].status);
+    EXPECT_EQ(a[k].depth, b[k].depth);
+    EXPECT_EQ(a[k].direction, b[k].direction);
+    EXPECT_EQ(a[k].inside_vertices, b[k].inside_vertices);
+    EXPECT_EQ(a[k].overlapping_triangles, b[k].overlapping_triangles);
+  }
+}
+
+TEST(PenetrationDepth, UndefinedCasesGetAStatus) {
+  const Object a = make_box(Vec3::Zero(), Vec3::Ones(), 2, "a");
+  const Object b = make_box(Vec3(0.7, 0.2, 0.1), Vec3::Ones(), 2, "b");
+  {  // B with one face removed: open
+    Object open = b;
+    auto topo = std::make_shared<Topology>(*b.topology);
+    topo->faces.pop_back();
+    open.topology = topo;
+    const auto pd = run_pd(frame_of({a, open}));
+    ASSERT_EQ(pd.size(), 1u);
+    EXPECT_EQ(pd[0].status, PdStatus::OpenSurface);
+  }
+  {  // B with one face flipped: inconsistently oriented
+    Object flipped = b;
+    auto topo = std::make_shared<Topology>(*b.topology);
+    std::swap(topo->faces[3][1], topo->faces[3][2]);
+    flipped.topology = topo;
+    const auto pd = run_pd(frame_of({a, flipped}));
+    ASSERT_EQ(pd.size(), 1u);
+    EXPECT_EQ(pd[0].status, PdStatus::NonOrientable);
+  }
+  {  // An edge shared by four faces: two boxes of one object touching along an edge
+    Object two = make_box(Vec3(0.7, 0.2, 0.1), Vec3::Ones(), 1, "b");
+    const Object c = make_box(Vec3(1.7, 1.2, 0.1), Vec3::Ones(), 1, "c");
+    auto topo = std::make_shared<Topology>(*two.topology);
+    // Weld c's vertices onto two's where they coincide (the shared edge x=1.7, y=1.2).
+    std::vector<Index> map;
+    for (const Vec3& p : c.positions) {
+      Index id = kNoIndex;
+      for (Index v = 0; v < static_cast<Index>(two.positions.size()); ++v)
+        if (two.positions[static_cast<size_t>(v)] == p) id = v;
+      if (id == kNoIndex) {
+        id = static_cast<Index>(two.positions.size());
+        two.positions.push_back(p);
+      }
+      map.push_back(id);
+    }
+    for (const Face& f : c.topology->faces)
+      topo->faces.push_back({map[static_cast<size_t>(f[0])], map[static_cast<size_t>(f[1])], map[static_cast<size_t>(f[2])]});
+    topo->num_vertices = static_cast<Index>(two.positions.size());
+    two.topology = topo;
+    const auto pd = run_pd(frame_of({a, two}));
+    ASSERT_GE(pd.size(), 1u);
+    EXPECT_EQ(pd[0].status, PdStatus::NonManifold);
+  }
+  {  // A small box swallowed by B, whose dented top reaches into it: all of A is inside B.
+    Object big = make_box(Vec3::Zero(), Vec3::Constant(3), 2, "big");
+    for (Vec3& p : big.positions)
+      if (p == Vec3(1.5, 1.5, 3)) p = Vec3(1.5, 1.5, 1);  // centre of the top face pushed down
+    const Object small = make_box(Vec3(1, 1, 0.5), Vec3::Ones(), 1, "small");
+    const auto pd = run_pd(frame_of({big, small}));
+    ASSERT_EQ(pd.size(), 1u);
+    EXPECT_EQ(pd[0].status, PdStatus::TooDeep) << pd_status_name(pd[0].status);
+    EXPECT_EQ(pd[0].inside_vertices[1].size(), 8u);
+  }
+  {  // A self-intersecting object: a documented status, no number
+    const Object merged = [&] {
+      Object m = make_box(Vec3::Zero(), Vec3::Ones(), 1, "m");
+      const Object other = make_box(Vec3(0.5, 0.2, 0.3), Vec3::Ones(), 1, "o");
+      auto topo = std::make_shared<Topology>(*m.topology);
+      const Index base = static_cast<Index>(m.positions.size());
+      for (const Vec3& p : other.positions) m.positions.push_back(p);
+      for (const Face& f : other.topology->faces) topo->faces.push_back({f[0] + base, f[1] + base, f[2] + base});
+      topo->num_vertices = static_cast<Index>(m.positions.size());
+      m.topology = topo;
+      return m;
+    }();
+    const auto pd = run_pd(frame_of({merged}));
+    ASSERT_EQ(pd.size(), 1u);
+    EXPECT_EQ(pd[0].objects, (std::array<Index, 2>{0, 0}));
+    EXPECT_EQ(pd[0].status, PdStatus::SelfIntersection);
+  }
+}
+
+TEST(PenetrationDepth, InsideVerticesAreTheWalkClosureOfBruteForceWinding) {
+  // On random overlapping blobs: the listed vertices of each side are exactly those reached
+  // from the intersecting triangles' vertices through vertices inside the other object, with
+  // "inside" from the brute-force winding number (every face, no BVH).
+  size_t checked = 0, ok = 0;
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    const Frame frame = test::make_random_frame(seed, 4, 1.0, 2);
+    const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
+    const auto pairs = intersecting_pairs(frame, boxes, {2, nullptr, false}).pairs;
+    const auto pd = penetration_depth(frame, boxes, pairs, {2}).pairs;
+    for (const PenetrationDepth& e : pd) {
+      SCOPED_TRACE("seed " + std::to_string(seed) + " objects " + std::to_string(e.objects[0]) + "," + std::to_string(e.objects[1]));
+      if (e.status != PdStatus::Ok && e.status != PdStatus::TooDeep) continue;
+      if (e.status == PdStatus::Ok) {
+        ++ok;
+        EXPECT_GE(e.depth, 0.0);
+        EXPECT_NEAR(e.direction.norm(), 1.0, 1e-12);
+      }
+      for (int side = 0; side < 2; ++side) {
+        const Object& own = frame.objects[static_cast<size_t>(e.objects[static_cast<size_t>(side)])];
+        const Object& other = frame.objects[static_cast<size_t>(e.objects[static_cast<size_t>(1 - side)])];
+        auto inside = [&](Index v) {
+          bool on = false;
+          const int w = winding_number_brute_force(own.positions[static_cast<size_t>(v)], other, on);
+          return !on && w != 0;
+        };
+        const auto& list = e.inside_vertices[static_cast<size_t>(side)];
+        auto listed = [&](Index v) { return std::binary_search(list.begin(), list.end(), v); };
+        for (Index v : list) EXPECT_TRUE(inside(v)) << "vertex " << v;
+        for (const IntersectingPair& p : pairs) {  // seeds
+          if (p.object_a != e.objects[0] || p.object_b != e.objects[1]) continue;
+          for (Index v : own.topology->faces[static_cast<size_t>(side == 0 ? p.tri_a : p.tri_b)])
+            EXPECT_EQ(listed(v), inside(v)) << "seed vertex " << v;
+        }
+        const Adjacency& adj = adjacency(*own.topology);
+        for (Index v : list)  // closed under inside neighbours
+          for (Index t : adj.vertex_triangles(v))
+            for (Index u : own.topology->faces[static_cast<size_t>(t)])
+              if (!listed(u)) {
+                EXPECT_FALSE(inside(u)) << "neighbour " << u << " of " << v;
+              }
+        checked += list.size();
+      }
+    }
+  }
+  std::printf("[ blobs ] %zu pd entries ok, %zu inside vertices checked\n", ok, checked);
+  EXPECT_GT(checked, 50u);
+  EXPECT_GT(ok, 3u);
+}
+
+TEST(PenetrationDepth, NoIntersectionNoEntry) {
+  const Frame frame = frame_of({make_box(Vec3::Zero(), Vec3::Ones(), 2, "a"), make_box(Vec3(1.01, 0, 0), Vec3::Ones(), 2, "b")});
+  EXPECT_TRUE(run_pd(frame).empty());
+}
+
+}  // namespace
+}  // namespace vproxq
