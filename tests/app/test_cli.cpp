@@ -142,7 +142,9 @@ TEST(Cli, InputErrorsNameTheFileAndLeaveNoOutput) {
     EXPECT_NE(r.output.find(c.expect), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(out / "results.json"));
     EXPECT_FALSE(fs::exists(out / "results.h5"));
-    if (fs::exists(out)) EXPECT_TRUE(fs::is_empty(out)) << "temporary files left behind";
+    if (fs::exists(out)) {
+      EXPECT_TRUE(fs::is_empty(out)) << "temporary files left behind";
+    }
   }
 }
 
