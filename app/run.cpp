@@ -5,9 +5,12 @@
 #include "core/query/inter_distance.hpp"
 #include "core/query/intersecting_pairs.hpp"
 #include "core/query/penetration_depth.hpp"
+#include "core/query/intra_distance.hpp"
 #include "core/timer.hpp"
+#include "core/voronoi/self_stage2.hpp"
 #include "core/voronoi/stage2.hpp"
 #include "gl/egl_context.hpp"
+#include "gl/self_voronoi_backend.hpp"
 #include "gl/voronoi_backend.hpp"
 #include "io/output.hpp"
 #include "io/scene_source.hpp"
@@ -83,10 +86,23 @@ void print_summary(const FrameResult& r) {
   }
 }
 
+void print_intra_summary(const FrameResult& r) {
+  if (!r.intra) return;
+  for (const auto& d : *r.intra) {
+    const auto& name = r.objects[static_cast<std::size_t>(d.object)].name;
+    if (!d.has_pair())
+      std::printf("  %4d %-16s self: no non-adjacent triangles\n", d.object, name.c_str());
+    else
+      std::printf("  %4d %-16s self distance %.17g  triangles %d,%d\n", d.object, name.c_str(),
+                  d.distance, d.triangles[0], d.triangles[1]);
+  }
+}
+
 /// The Stage II backend of a run, and the GL context it may need (destroyed after it).
 struct VoronoiStage {
   std::optional<gl::Context> context;
   std::unique_ptr<DiscreteVoronoiBackend> backend;
+  std::unique_ptr<SelfVoronoiBackend> self_backend;  ///< the same kind, for the intra query
 };
 
 VoronoiStage make_voronoi_stage(const Config& config, int threads) {
@@ -107,11 +123,55 @@ VoronoiStage make_voronoi_stage(const Config& config, int threads) {
       stage.context.emplace(std::move(*r.context));
     }
   }
-  if (stage.context)
+  if (stage.context) {
     stage.backend = std::make_unique<gl::GlVoronoiBackend>(*stage.context);
-  else
+    stage.self_backend = std::make_unique<gl::GlSelfVoronoiBackend>(*stage.context);
+  } else {
     stage.backend = make_cpu_voronoi_backend(threads);
+    stage.self_backend = make_cpu_self_voronoi_backend(threads);
+  }
   return stage;
+}
+
+VoronoiFrameStats frame_stats(const SelfVoronoiBounds& b) {
+  VoronoiFrameStats v;
+  v.grid_dims = b.grid.dims;
+  v.cell = b.grid.cell;
+  v.delta = b.delta;
+  v.delta_precision = b.delta_precision;
+  v.sample_voxels = b.sample_voxels;
+  v.samples = b.samples;
+  v.setup_ms = b.setup_ms;
+  v.upload_ms = b.upload_ms;
+  v.compute_ms = b.compute_ms;
+  v.readback_ms = b.readback_ms;
+  v.scan_ms = b.scan_ms;
+  return v;
+}
+
+/// The intra-object ("self") part of the distance query: 2-ring bounds, the self Stage II when
+/// a backend runs (at `grid` when given, else its own default), Stage III. Its times add to
+/// the frame's voronoi and exact times.
+void run_intra(const Frame& frame, const FrameBoxes& boxes, VoronoiStage& voronoi, int grid,
+               int threads, FrameResult& result) {
+  Stopwatch sw;
+  const auto ring2 = ring2_upper_bounds(frame, threads);
+  IntraDistanceOptions opts{threads, nullptr};
+  SelfVoronoiBounds bounds;
+  if (voronoi.self_backend) {
+    bounds = compute_self_voronoi_bounds(frame, boxes, ring2, *voronoi.self_backend, grid, threads);
+    opts.voronoi = &bounds;
+    result.self_voronoi = frame_stats(bounds);
+  }
+  result.time_ms.intra_voronoi = sw.elapsed_ms();
+  result.time_ms.voronoi += result.time_ms.intra_voronoi;
+  IntraDistanceOutput d = intra_object_distance(frame, boxes, ring2, opts);
+  result.time_ms.intra_exact = d.exact_ms;
+  result.time_ms.exact += d.exact_ms;
+  result.counters.intra_candidates = d.counters.intra_candidates;
+  result.counters.intra_voronoi_culled = d.counters.intra_voronoi_culled;
+  result.counters.intra_exact_tests = d.counters.intra_exact_tests;
+  result.intra = std::move(d.per_object);
 }
 
 }  // namespace
@@ -193,6 +253,7 @@ void run(const Config& config) {
         result.time_ms.exact = d.exact_ms;
         result.counters = d.counters;
         result.inter = std::move(d.per_object);
+        run_intra(frame, boxes, voronoi, grid, info.threads, result);
       }
       // Discrete collisions (paper 3.2), then local penetration depth (3.3) from them; their
       // time counts as exact tests.
@@ -210,6 +271,7 @@ void run(const Config& config) {
     } else if (!config.quiet) {
       progress.finish();
       print_summary(result);
+      print_intra_summary(result);
     }
     progress.update(static_cast<std::size_t>(k - first + 1));
   }

@@ -23,16 +23,46 @@ struct InterObjectDistance {
   bool has_nearest() const { return nearest_object != kNoIndex; }
 };
 
+/// Intra-object ("self") distance of one triangle f: its nearest non-adjacent triangle of the
+/// same object (adjacent = shares a vertex; f itself excluded). nearest is kNoIndex (distance
+/// infinite) when every other triangle of the object shares a vertex with f.
+struct IntraTriangleNearest {
+  Index nearest = kNoIndex;
+  double distance = kInfinity;  ///< 0 when f and nearest touch or intersect
+  std::array<Vec3, 2> points{Vec3::Zero(), Vec3::Zero()};  ///< {on f, on nearest}
+  TriangleDistanceCase kind = TriangleDistanceCase::Intersecting;  ///< from f's side
+};
+
+/// Intra-object distance of one object: per triangle its nearest non-adjacent triangle, and the
+/// object's minimum, the smallest (distance, triangle, nearest) over its triangles. Without any
+/// non-adjacent pair, triangles are kNoIndex and distance is infinite.
+struct IntraObjectDistance {
+  Index object = kNoIndex;
+  double distance = kInfinity;
+  std::array<Index, 2> triangles{kNoIndex, kNoIndex};  ///< {f, its nearest}
+  std::array<Vec3, 2> points{Vec3::Zero(), Vec3::Zero()};
+  std::vector<IntraTriangleNearest> per_triangle;  ///< indexed by triangle
+
+  bool has_pair() const { return triangles[0] != kNoIndex; }
+};
+
 /// Work counters of one query run on one frame.
 struct DistanceCounters {
   std::uint64_t object_pns_pairs = 0;  ///< ordered object pairs (i, j) kept by the broad phase
   std::uint64_t feature_pns = 0;   ///< feature-level PNS: (triangle, object) pairs kept by culling
   std::uint64_t exact_tests = 0;       ///< triangle–triangle distance evaluations
+  /// Intra-object query: non-adjacent (f, g) pairs whose boxes passed the AABB test, how many of
+  /// those Stage II's bounds culled, and the triangle–triangle distance evaluations that ran.
+  std::uint64_t intra_candidates = 0;
+  std::uint64_t intra_voronoi_culled = 0;
+  std::uint64_t intra_exact_tests = 0;
 };
 
 /// Wall-clock milliseconds per stage.
 struct StageTimes {
   double load = 0, aabb = 0, voronoi = 0, exact = 0, write = 0, total = 0;
+  /// The intra-object query's share of voronoi (2-ring bounds + self Stage II) and of exact.
+  double intra_voronoi = 0, intra_exact = 0;
 };
 
 /// What Stage II did on one frame (absent when it did not run).
@@ -42,6 +72,7 @@ struct VoronoiFrameStats {
   double delta = 0;            ///< Lemma 2's δ = cell diagonal / 2 + slack + δ_precision
   double delta_precision = 0;  ///< the backend's arithmetic error bound
   std::uint64_t sample_voxels = 0;
+  std::uint64_t samples = 0;  ///< self Stage II: (voxel, triangle) samples (0 for inter-object)
   double setup_ms = 0, upload_ms = 0, compute_ms = 0, readback_ms = 0, scan_ms = 0;
 };
 
@@ -128,9 +159,11 @@ struct FrameResult {
   std::optional<std::vector<IntersectingPair>> intersecting_pairs;
   std::uint64_t intersection_tests = 0;  ///< exact triangle–triangle intersection tests
   std::optional<std::vector<PenetrationDepth>> pd;  ///< set when "pd" ran; one per object pair
+  std::optional<std::vector<IntraObjectDistance>> intra;  ///< set when "distance" ran
   DistanceCounters counters;
   StageTimes time_ms;
   std::optional<VoronoiFrameStats> voronoi;
+  std::optional<VoronoiFrameStats> self_voronoi;  ///< the intra-object query's Stage II
 };
 
 /// What a run was asked and how it ran; written once at the top of each output file.

@@ -52,6 +52,18 @@ struct FeatureRow {  // one overlapping feature of one pd row
   std::int32_t pair, object, id;
 };
 
+// One row of distance/intra: triangle `triangle` of object `object` and its nearest
+// non-adjacent triangle; one row of distance/intra_min: an object's minimum.
+struct IntraRow {
+  std::int32_t object;
+  std::int32_t triangle;
+  std::int32_t nearest;
+  double distance;
+  double point_a[3];
+  double point_b[3];
+  std::uint8_t kind;  // field "case"
+};
+
 // File codes of TriangleDistanceCase, fixed by the file format (not by the enum's order).
 std::uint8_t case_code(TriangleDistanceCase kind) {
   switch (kind) {
@@ -93,6 +105,7 @@ struct Hdf5ResultWriter::Impl {
   Handle pd_mem_type, pd_file_type;
   Handle vertex_feature_mem_type, vertex_feature_file_type;
   Handle triangle_feature_mem_type, triangle_feature_file_type;
+  Handle intra_mem_type, intra_file_type;
   Handle transfer;        ///< dataset transfer list, its buffer sized to each write
   Handle group_creation;  ///< keeps up to kCompactAttributes attributes in the object header
 
@@ -192,6 +205,15 @@ struct Hdf5ResultWriter::Impl {
          {"point_b", offsetof(InterRow, point_b), point_mem.get(), point_file.get()},
          {"case", offsetof(InterRow, kind), H5T_NATIVE_UINT8, H5T_STD_U8LE}},
         sizeof(InterRow), inter_mem_type, inter_file_type);
+    build_compound(
+        {{"object", offsetof(IntraRow, object), H5T_NATIVE_INT32, H5T_STD_I32LE},
+         {"triangle", offsetof(IntraRow, triangle), H5T_NATIVE_INT32, H5T_STD_I32LE},
+         {"nearest", offsetof(IntraRow, nearest), H5T_NATIVE_INT32, H5T_STD_I32LE},
+         {"distance", offsetof(IntraRow, distance), H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE},
+         {"point_a", offsetof(IntraRow, point_a), point_mem.get(), point_file.get()},
+         {"point_b", offsetof(IntraRow, point_b), point_mem.get(), point_file.get()},
+         {"case", offsetof(IntraRow, kind), H5T_NATIVE_UINT8, H5T_STD_U8LE}},
+        sizeof(IntraRow), intra_mem_type, intra_file_type);
     build_pd_types(point_mem.get(), point_file.get());
   }
 
@@ -399,6 +421,58 @@ struct Hdf5ResultWriter::Impl {
     close_checked(distance, "H5Gclose", dist_where);
   }
 
+  // The frame's "distance" group: opened when another query's block already made it.
+  Handle distance_group(hid_t group, const std::string& where) const {
+    const std::string dist_where = where + "/distance";
+    const htri_t exists = H5Lexists(group, "distance", H5P_DEFAULT);
+    check_ok(exists < 0 ? -1 : 0, "H5Lexists", dist_where);
+    if (exists == 0) return create_group(group, "distance", dist_where);
+    return Handle(check_id(H5Gopen2(group, "distance", H5P_DEFAULT), "H5Gopen2", dist_where),
+                  H5Gclose);
+  }
+
+  // distance/intra: every triangle of every object (object-major, triangle order) with its
+  // nearest non-adjacent triangle; distance/intra_min: one row per object, its minimum
+  // (triangle and nearest are the pair). No such triangle: nearest -1, distance +inf, points
+  // NaN, case 255.
+  void write_intra(hid_t group, const std::string& where,
+                   const std::vector<IntraObjectDistance>& intra) const {
+    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+    auto row_of = [&](Index object, Index triangle, Index nearest, double distance,
+                      const std::array<Vec3, 2>& points, TriangleDistanceCase kind) {
+      IntraRow row{};
+      row.object = object;
+      row.triangle = triangle;
+      row.nearest = nearest;
+      const bool none = nearest == kNoIndex;
+      row.distance = none ? kInfinity : distance;
+      for (int k = 0; k < 3; ++k) {
+        row.point_a[k] = none ? kNaN : points[0][k];
+        row.point_b[k] = none ? kNaN : points[1][k];
+      }
+      row.kind = none ? kHdf5CaseNone : case_code(kind);
+      return row;
+    };
+    std::vector<IntraRow> rows, mins;
+    for (const IntraObjectDistance& d : intra) {
+      for (size_t t = 0; t < d.per_triangle.size(); ++t) {
+        const IntraTriangleNearest& n = d.per_triangle[t];
+        rows.push_back(row_of(d.object, static_cast<Index>(t), n.nearest, n.distance, n.points, n.kind));
+      }
+      const TriangleDistanceCase kind =
+          d.has_pair() ? d.per_triangle[static_cast<size_t>(d.triangles[0])].kind
+                       : TriangleDistanceCase::Intersecting;
+      mins.push_back(row_of(d.object, d.triangles[0], d.triangles[1], d.distance, d.points, kind));
+    }
+    const std::string dist_where = where + "/distance";
+    Handle distance = distance_group(group, where);
+    write_dataset(distance.get(), dist_where, "intra", intra_file_type.get(),
+                  intra_mem_type.get(), rows.size(), rows.data());
+    write_dataset(distance.get(), dist_where, "intra_min", intra_file_type.get(),
+                  intra_mem_type.get(), mins.size(), mins.data());
+    close_checked(distance, "H5Gclose", dist_where);
+  }
+
   void write_stats(hid_t group, const std::string& where, const FrameResult& frame,
                    double write_ms) const {
     const std::string stats_where = where + "/stats";
@@ -430,6 +504,22 @@ struct Hdf5ResultWriter::Impl {
       write_attribute(s, stats_where, "voronoi_time_ms_upload", v.upload_ms);
       write_attribute(s, stats_where, "voronoi_time_ms_compute", v.compute_ms);
       write_attribute(s, stats_where, "voronoi_time_ms_readback", v.readback_ms);
+    }
+    if (frame.intra) {
+      write_attribute(s, stats_where, "intra_exact_tests", std::uint64_t{frame.counters.intra_exact_tests});
+      write_attribute(s, stats_where, "intra_candidates", std::uint64_t{frame.counters.intra_candidates});
+      write_attribute(s, stats_where, "intra_voronoi_culled", std::uint64_t{frame.counters.intra_voronoi_culled});
+    }
+    if (frame.self_voronoi) {
+      const VoronoiFrameStats& v = *frame.self_voronoi;
+      for (int k = 0; k < 3; ++k) {
+        const std::string name = std::string("self_voronoi_grid_") + "xyz"[k];
+        write_attribute(s, stats_where, name.c_str(), std::int32_t{v.grid_dims[static_cast<size_t>(k)]});
+      }
+      write_attribute(s, stats_where, "self_voronoi_cell", v.cell);
+      write_attribute(s, stats_where, "self_voronoi_delta", v.delta);
+      write_attribute(s, stats_where, "self_voronoi_samples", std::uint64_t{v.samples});
+      write_attribute(s, stats_where, "self_voronoi_time_ms_compute", v.compute_ms);
     }
     close_checked(stats, "H5Gclose", stats_where);
   }
@@ -482,6 +572,7 @@ double Hdf5ResultWriter::write_frame(const FrameResult& frame,
   if (frame.inter) m.write_inter(group.get(), where, *frame.inter);
   if (frame.intersecting_pairs) m.write_intersecting_pairs(group.get(), where, *frame.intersecting_pairs);
   if (frame.pd) m.write_pd(group.get(), where, *frame.pd);
+  if (frame.intra) m.write_intra(group.get(), where, *frame.intra);
 
   const double write_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started)

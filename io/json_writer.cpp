@@ -47,6 +47,34 @@ Json pd_json(const PenetrationDepth& p) {
   return r;
 }
 
+Json intra_json(const IntraObjectDistance& d) {
+  Json r;
+  r["object"] = d.object;
+  if (d.has_pair()) {
+    r["distance"] = d.distance;
+    r["triangles"] = Json::array({d.triangles[0], d.triangles[1]});
+    r["points"] = Json::array({point_json(d.points[0]), point_json(d.points[1])});
+  } else {  // no two triangles of the object are non-adjacent
+    r["distance"] = nullptr;
+    r["triangles"] = nullptr;
+    r["points"] = nullptr;
+  }
+  return r;
+}
+
+Json voronoi_stats_json(const VoronoiFrameStats& v) {
+  Json vj;
+  vj["grid"] = {v.grid_dims[0], v.grid_dims[1], v.grid_dims[2]};
+  vj["cell"] = v.cell;
+  vj["delta"] = v.delta;
+  vj["delta_precision"] = v.delta_precision;
+  vj["sample_voxels"] = v.sample_voxels;
+  vj["samples"] = v.samples;
+  vj["time_ms"] = {{"setup", v.setup_ms}, {"upload", v.upload_ms}, {"compute", v.compute_ms},
+                   {"readback", v.readback_ms}, {"scan", v.scan_ms}};
+  return vj;
+}
+
 // True when format_json spreads `value` over several lines.
 bool spreads(const Json& value) {
   if (value.is_array()) {
@@ -131,6 +159,11 @@ Json frame_json(const FrameResult& frame, double write_ms) {
     for (const PenetrationDepth& p : *frame.pd) pd.push_back(pd_json(p));
     j["pd"] = std::move(pd);
   }
+  if (frame.intra) {
+    Json intra = Json::array();
+    for (const IntraObjectDistance& d : *frame.intra) intra.push_back(intra_json(d));
+    j["distance"]["intra"] = std::move(intra);
+  }
   const StageTimes& t = frame.time_ms;
   Json time_ms;
   time_ms["load"] = t.load;
@@ -139,12 +172,21 @@ Json frame_json(const FrameResult& frame, double write_ms) {
   time_ms["exact"] = t.exact;
   time_ms["write"] = write_ms;
   time_ms["total"] = t.total;
+  if (frame.intra) {
+    time_ms["intra_voronoi"] = t.intra_voronoi;
+    time_ms["intra_exact"] = t.intra_exact;
+  }
   Json stats;
   stats["time_ms"] = std::move(time_ms);
   stats["exact_tests"] = frame.counters.exact_tests;
   stats["pns_pairs"] = frame.counters.object_pns_pairs;
   stats["feature_pns"] = frame.counters.feature_pns;
   if (frame.intersecting_pairs) stats["intersection_tests"] = frame.intersection_tests;
+  if (frame.intra) {
+    stats["intra_exact_tests"] = frame.counters.intra_exact_tests;
+    stats["intra_candidates"] = frame.counters.intra_candidates;
+    stats["intra_voronoi_culled"] = frame.counters.intra_voronoi_culled;
+  }
   if (frame.voronoi) {
     const VoronoiFrameStats& v = *frame.voronoi;
     Json vj;
@@ -157,6 +199,7 @@ Json frame_json(const FrameResult& frame, double write_ms) {
                      {"readback", v.readback_ms}, {"scan", v.scan_ms}};
     stats["voronoi"] = std::move(vj);
   }
+  if (frame.self_voronoi) stats["self_voronoi"] = voronoi_stats_json(*frame.self_voronoi);
   j["stats"] = std::move(stats);
   return j;
 }

@@ -1,9 +1,9 @@
 #include "core/voronoi/stage2.hpp"
 
-#include "core/geometry/triangle_box.hpp"
 #include "core/parallel.hpp"
 #include "core/timer.hpp"
 #include "core/voronoi/bins.hpp"
+#include "core/voronoi/grid_setup.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,12 +12,7 @@
 namespace vproxq {
 namespace {
 
-// Voxelization: the SAT test runs in double on coordinates relative to the grid origin, of
-// magnitude <= the grid extent E; its projections are off by at most a few ulps of E. Widening
-// the voxel's half side by kVoxelSlackRel * (E + cell) (~4.5e6 ulps) makes the test
-// conservative: every voxel that the exact triangle touches is marked. A marked voxel centre
-// is then within (cell/2 + slack) * sqrt(3) of the triangle, which δ accounts for.
-constexpr double kVoxelSlackRel = 1e-9;
+// Voxelization and its slack: StageGrid (grid_setup.hpp), shared with the self Stage II.
 // Bands are capped at this many cells: a narrower band only weakens culling, never
 // correctness (values at the cap give D_l = cap - δ, which then simply does not cull).
 constexpr double kMaxBandCells = 3.0;
@@ -57,45 +52,20 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
 
   // Grid: cubic cells, `res` cells along the longest axis.
   const int res = grid_resolution > 0 ? grid_resolution : default_grid_resolution(total_tris);
-  const Vec3 ext = scene.hi - scene.lo;
-  const double longest = std::max(ext.maxCoeff(), 1e-300);
+  const StageGrid sg = StageGrid::over(scene, res);
   VoronoiGrid& grid = out.grid;
-  grid.cell = longest / res;
-  grid.origin = scene.lo;
-  for (int k = 0; k < 3; ++k)
-    grid.dims[k] = std::max<std::int32_t>(1, static_cast<std::int32_t>(std::ceil(ext[k] / grid.cell)));
-  const double extent = (grid.cell * Vec3(grid.dims[0], grid.dims[1], grid.dims[2])).norm();
-  const double voxel_slack = kVoxelSlackRel * (extent + grid.cell);
-  const double half = 0.5 * grid.cell + voxel_slack;
-  out.delta_precision = backend.distance_error_bound(extent);
-  out.delta = std::sqrt(3.0) * half + out.delta_precision;
+  grid = sg.grid;
+  out.delta_precision = backend.distance_error_bound(sg.extent);
+  out.delta = sg.delta(out.delta_precision);
   const double slack = rounding_slack(boxes.magnitude);
 
   // Conservative voxelization, per object in parallel, then merged in object order.
   std::vector<std::vector<VoxelHit>> hits(n);
   parallel_for(n, threads, [&](size_t i) {
     const Object& o = frame.objects[i];
-    for (Index t = 0; t < o.num_triangles(); ++t) {
-      Triangle tri = o.triangle(t);
-      for (auto& p : tri) p -= grid.origin;
-      const AABB& tb = boxes.triangles[i][static_cast<size_t>(t)];
-      std::array<std::int32_t, 3> lo{}, hi{};
-      for (int k = 0; k < 3; ++k) {
-        auto cell_of = [&](double x) {
-          return std::clamp<std::int32_t>(static_cast<std::int32_t>(std::floor(x / grid.cell)), 0, grid.dims[k] - 1);
-        };
-        lo[k] = cell_of(tb.lo[k] - grid.origin[k] - voxel_slack);
-        hi[k] = cell_of(tb.hi[k] - grid.origin[k] + voxel_slack);
-      }
-      for (std::int32_t z = lo[2]; z <= hi[2]; ++z)
-        for (std::int32_t y = lo[1]; y <= hi[1]; ++y)
-          for (std::int32_t x = lo[0]; x <= hi[0]; ++x) {
-            const Vec3 c = grid.cell * Vec3(x + 0.5, y + 0.5, z + 0.5);
-            if (!triangle_box_overlap(tri, c, half)) continue;
-            const std::int64_t id = x + std::int64_t{grid.dims[0]} * (y + std::int64_t{grid.dims[1]} * z);
-            hits[i].push_back({id, static_cast<Index>(i), t});
-          }
-    }
+    for (Index t = 0; t < o.num_triangles(); ++t)
+      sg.voxelize(o.triangle(t), boxes.triangles[i][static_cast<size_t>(t)],
+                  [&](std::int64_t id) { hits[i].push_back({id, static_cast<Index>(i), t}); });
   });
 
   // Bands: object i needs exact values up to U_i + δ (+ slack) so that its capped triangles
@@ -125,25 +95,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   out.sample_voxels = in.voxels.size();
 
   // Triangles relative to the origin, in object order.
-  std::vector<std::int64_t> tri_base(n + 1, 0);
-  for (size_t i = 0; i < n; ++i) tri_base[i + 1] = tri_base[i] + frame.objects[i].num_triangles();
-  in.tri_xyz.resize(static_cast<size_t>(tri_base[n]) * 9);
-  in.tri_xyz_d.resize(in.tri_xyz.size());
-  in.tri_site.resize(static_cast<size_t>(tri_base[n]));
-  for (size_t i = 0; i < n; ++i) {
-    const Object& o = frame.objects[i];
-    for (Index t = 0; t < o.num_triangles(); ++t) {
-      const size_t g = static_cast<size_t>(tri_base[i] + t);
-      const Triangle tri = o.triangle(t);
-      for (int c = 0; c < 3; ++c)
-        for (int k = 0; k < 3; ++k) {
-          const double v = tri[static_cast<size_t>(c)][k] - grid.origin[k];
-          in.tri_xyz_d[g * 9 + static_cast<size_t>(c * 3 + k)] = v;
-          in.tri_xyz[g * 9 + static_cast<size_t>(c * 3 + k)] = static_cast<float>(v);
-        }
-      in.tri_site[g] = static_cast<std::int32_t>(i);
-    }
-  }
+  fill_dvd_triangles(in, frame);
   bin_triangles(in, kBinSize);
   out.setup_ms = sw.elapsed_ms();
 

@@ -1,0 +1,210 @@
+#include "core/query/intra_distance.hpp"
+
+#include "core/broad_phase/triangle_bvh.hpp"
+#include "core/mesh/adjacency.hpp"
+#include "core/parallel.hpp"
+#include "core/timer.hpp"
+#include "core/voronoi/self_stage2.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+
+namespace vproxq {
+namespace {
+
+// Vertex pair distances are a few roundings away from exact; widening them by 1e-12 relative
+// keeps the 2-ring bound an upper bound of the exact distance (as Stage I does for U_i).
+constexpr double kUpperBoundWidening = 1e-12;
+// Triangles per work item of the parallel loops (counters are summed per item).
+constexpr std::size_t kBlock = 64;
+
+/// Distance between triangles f and g of one object, always evaluated with the lower id first,
+/// so that f's and g's searches get bitwise the same numbers. Expressed from f's side.
+TriangleDistanceResult evaluate(const Object& o, Index f, Index g) {
+  if (f < g) return triangle_distance(o.triangle(f), o.triangle(g));
+  TriangleDistanceResult r = triangle_distance(o.triangle(g), o.triangle(f));
+  std::swap(r.point_a, r.point_b);
+  std::swap(r.feature_a, r.feature_b);
+  if (r.kind == TriangleDistanceCase::VertexFace)
+    r.kind = TriangleDistanceCase::FaceVertex;
+  else if (r.kind == TriangleDistanceCase::FaceVertex)
+    r.kind = TriangleDistanceCase::VertexFace;
+  return r;
+}
+
+/// Keeps the smallest (distance, g): the tie-break shared with the brute force.
+void consider(const Object& o, Index f, Index g, IntraTriangleNearest& best) {
+  const TriangleDistanceResult r = evaluate(o, f, g);
+  if (std::tie(r.distance, g) < std::tie(best.distance, best.nearest)) {
+    best.nearest = g;
+    best.distance = r.distance;
+    best.points = {r.point_a, r.point_b};
+    best.kind = r.kind;
+  }
+}
+
+/// Fills in the object's minimum from its per-triangle table: smallest (distance, f, g).
+void finish_object(IntraObjectDistance& out) {
+  for (Index f = 0; f < static_cast<Index>(out.per_triangle.size()); ++f) {
+    const IntraTriangleNearest& t = out.per_triangle[static_cast<size_t>(f)];
+    if (t.nearest == kNoIndex) continue;
+    if (std::tie(t.distance, f, t.nearest) <
+        std::tie(out.distance, out.triangles[0], out.triangles[1])) {
+      out.distance = t.distance;
+      out.triangles = {f, t.nearest};
+      out.points = t.points;
+    }
+  }
+}
+
+bool shares_vertex(const Object& o, Index f, Index g) {
+  return Adjacency::share_vertex(o.topology->faces[static_cast<size_t>(f)],
+                                 o.topology->faces[static_cast<size_t>(g)]);
+}
+
+}  // namespace
+
+std::vector<std::vector<double>> ring2_upper_bounds(const Frame& frame, int threads) {
+  std::vector<std::vector<double>> out(frame.objects.size());
+  for (size_t i = 0; i < frame.objects.size(); ++i) {
+    const Object& o = frame.objects[i];
+    const size_t n = static_cast<size_t>(o.num_triangles());
+    out[i].assign(n, kInfinity);
+    if (n == 0) continue;
+    const Adjacency& adj = adjacency(*o.topology);
+    const auto& faces = o.topology->faces;
+    parallel_for((n + kBlock - 1) / kBlock, threads, [&](size_t block) {
+      for (size_t f = block * kBlock; f < std::min(n, (block + 1) * kBlock); ++f) {
+        double best2 = kInfinity;
+        for (Index g : adj.ring2(static_cast<Index>(f)))
+          for (Index a : faces[f])
+            for (Index b : faces[static_cast<size_t>(g)])
+              best2 = std::min(best2, (o.positions[static_cast<size_t>(a)] -
+                                       o.positions[static_cast<size_t>(b)]).squaredNorm());
+        out[i][f] = std::sqrt(best2) * (1 + kUpperBoundWidening);
+      }
+    });
+  }
+  return out;
+}
+
+IntraDistanceOutput intra_object_distance(const Frame& frame, const IntraDistanceOptions& opts) {
+  const int threads = std::max(1, opts.threads);
+  const FrameBoxes boxes = FrameBoxes::compute(frame, threads);
+  return intra_object_distance(frame, boxes, ring2_upper_bounds(frame, threads), opts);
+}
+
+IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& boxes,
+                                          const std::vector<std::vector<double>>& ring2_bound,
+                                          const IntraDistanceOptions& opts) {
+  Stopwatch sw;
+  IntraDistanceOutput out;
+  const int threads = std::max(1, opts.threads);
+  const double slack = rounding_slack(boxes.magnitude);
+  const size_t n_obj = frame.objects.size();
+  out.per_object.resize(n_obj);
+  for (size_t i = 0; i < n_obj; ++i) {
+    const Object& o = frame.objects[i];
+    IntraObjectDistance& res = out.per_object[i];
+    res.object = static_cast<Index>(i);
+    const size_t n = static_cast<size_t>(o.num_triangles());
+    res.per_triangle.assign(n, {});
+    if (n < 2) continue;
+    const auto& tboxes = boxes.triangles[i];
+    TriangleBvh bvh;
+    bvh.build(tboxes);
+    const double* upper = opts.voronoi ? opts.voronoi->triangle_upper[i].data() : nullptr;
+    const double* lower = opts.voronoi ? opts.voronoi->triangle_lower[i].data() : nullptr;
+    std::vector<DistanceCounters> counters((n + kBlock - 1) / kBlock);
+    parallel_for(counters.size(), threads, [&](size_t block) {
+      DistanceCounters& c = counters[block];
+      for (size_t uf = block * kBlock; uf < std::min(n, (block + 1) * kBlock); ++uf) {
+        const Index f = static_cast<Index>(uf);
+        // D_u(f): the 2-ring bound, or Stage II's (which already includes it) when smaller.
+        const double u = upper ? std::min(ring2_bound[i][uf], upper[uf]) : ring2_bound[i][uf];
+        IntraTriangleNearest& best = res.per_triangle[uf];
+        auto bound = [&] { return std::min(u, best.distance) + slack; };
+        // Nearest boxes first, so that the bound drops early. A pair at distance d <= bound
+        // has D_l(g) <= SD(g) <= d (f is non-adjacent to g), so the D_l cut loses nothing.
+        bvh.query(tboxes[uf], bound, [&](Index g, double) {
+          if (g == f || shares_vertex(o, f, g)) return;
+          ++c.intra_candidates;
+          if (lower && lower[g] > bound()) {
+            ++c.intra_voronoi_culled;
+            return;
+          }
+          ++c.intra_exact_tests;
+          consider(o, f, g, best);
+        });
+      }
+    });
+    for (const auto& c : counters) {
+      out.counters.intra_candidates += c.intra_candidates;
+      out.counters.intra_voronoi_culled += c.intra_voronoi_culled;
+      out.counters.intra_exact_tests += c.intra_exact_tests;
+    }
+    finish_object(res);
+  }
+  out.exact_ms = sw.elapsed_ms();
+  return out;
+}
+
+IntraDistanceOutput intra_object_distance_brute_force(const Frame& frame, int threads) {
+  IntraDistanceOutput out;
+  out.per_object.resize(frame.objects.size());
+  for (size_t i = 0; i < frame.objects.size(); ++i) {
+    const Object& o = frame.objects[i];
+    IntraObjectDistance& res = out.per_object[i];
+    res.object = static_cast<Index>(i);
+    const Index n = o.num_triangles();
+    res.per_triangle.assign(static_cast<size_t>(n), {});
+    parallel_for(static_cast<size_t>(n), std::max(1, threads), [&](size_t uf) {
+      const Index f = static_cast<Index>(uf);
+      for (Index g = 0; g < n; ++g)
+        if (g != f && !shares_vertex(o, f, g)) consider(o, f, g, res.per_triangle[uf]);
+    });
+    for (Index f = 0; f < n; ++f)
+      for (Index g = 0; g < n; ++g)
+        if (g != f && !shares_vertex(o, f, g)) ++out.counters.intra_exact_tests;
+    finish_object(res);
+  }
+  out.counters.intra_candidates = out.counters.intra_exact_tests;
+  return out;
+}
+
+IntraDistanceOutput intra_object_distance_sorted_scan(const Frame& frame, int threads) {
+  IntraDistanceOutput out;
+  const FrameBoxes boxes = FrameBoxes::compute(frame, std::max(1, threads));
+  const double slack = rounding_slack(boxes.magnitude);
+  out.per_object.resize(frame.objects.size());
+  for (size_t i = 0; i < frame.objects.size(); ++i) {
+    const Object& o = frame.objects[i];
+    IntraObjectDistance& res = out.per_object[i];
+    res.object = static_cast<Index>(i);
+    const size_t n = static_cast<size_t>(o.num_triangles());
+    res.per_triangle.assign(n, {});
+    const auto& tb = boxes.triangles[i];
+    std::vector<std::uint64_t> tests(n, 0);
+    parallel_for(n, std::max(1, threads), [&](size_t uf) {
+      std::vector<std::pair<double, Index>> order;
+      order.reserve(n);
+      for (size_t g = 0; g < n; ++g) order.emplace_back(box_distance_squared(tb[uf], tb[g]), static_cast<Index>(g));
+      std::sort(order.begin(), order.end());
+      IntraTriangleNearest& best = res.per_triangle[uf];
+      for (const auto& [d2, g] : order) {
+        const double b = best.distance + slack;  // box distance <= triangle distance
+        if (d2 > b * b) break;
+        if (g == static_cast<Index>(uf) || shares_vertex(o, static_cast<Index>(uf), g)) continue;
+        consider(o, static_cast<Index>(uf), g, best);
+        ++tests[uf];
+      }
+    });
+    for (auto t : tests) out.counters.intra_exact_tests += t;
+    finish_object(res);
+  }
+  out.counters.intra_candidates = out.counters.intra_exact_tests;
+  return out;
+}
+
+}  // namespace vproxq

@@ -1,0 +1,63 @@
+#pragma once
+// Intra-object ("self") distance (paper 3, 5.2.2, fig. 3): for every triangle f of every object,
+// its nearest triangle of the same object that shares no vertex with f (f's 1-ring and f itself
+// are its adjacent features and are excluded), and per object the minimum.
+#include "core/broad_phase/object_broad_phase.hpp"
+#include "core/results.hpp"
+#include "core/scene.hpp"
+
+#include <vector>
+
+namespace vproxq {
+
+struct SelfVoronoiBounds;
+
+/// Per object and triangle, an upper bound of the triangle's intra-object distance from its
+/// 2-ring (paper 5.2.2): the smallest distance between a vertex of f and a vertex of a 2-ring
+/// triangle (2-ring triangles share no vertex with f, so each is a valid non-adjacent
+/// candidate, and a vertex pair's distance bounds the triangle pair's). kInfinity when the
+/// 2-ring is empty. Cheap (no triangle–triangle tests): the 2-ring triangles are tested in
+/// Stage III like any other candidate, only when they survive culling.
+std::vector<std::vector<double>> ring2_upper_bounds(const Frame& frame, int threads);
+
+struct IntraDistanceOptions {
+  int threads = 1;  ///< worker threads for Stage III (>= 1)
+  /// Stage II's per-triangle bounds (D_u, D_l) for this frame, or null for AABB-only culling.
+  /// They change which pairs are tested, never the answer.
+  const SelfVoronoiBounds* voronoi = nullptr;
+};
+
+struct IntraDistanceOutput {
+  std::vector<IntraObjectDistance> per_object;  ///< indexed by object id
+  DistanceCounters counters;                    ///< the intra_* fields
+  double exact_ms = 0;                          ///< BVHs, candidates and exact tests
+};
+
+/// Stage III of the intra-object query. For each triangle f, a BVH range query around f's box
+/// with the current bound min(2-ring bound, D_u(f), best so far) (+ rounding slack); triangles
+/// sharing a vertex with f are skipped, with Stage II a triangle g is skipped when D_l(g)
+/// exceeds the bound, and the exact test runs on what is left.
+///
+/// Deterministic and thread-count independent: every unordered pair {f, g} is evaluated as
+/// triangle_distance(triangle min(f, g), triangle max(f, g)) (points swapped for the other
+/// side), f's answer is the smallest (distance, g) and the object's the smallest
+/// (distance, f, g): bitwise the brute force's. `ring2_bound` is ring2_upper_bounds(frame).
+IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& boxes,
+                                          const std::vector<std::vector<double>>& ring2_bound,
+                                          const IntraDistanceOptions& opts);
+
+/// The same, computing the boxes and the 2-ring bounds itself.
+IntraDistanceOutput intra_object_distance(const Frame& frame, const IntraDistanceOptions& opts);
+
+/// All non-adjacent pairs of every object, no culling: the reference for tests. `threads`
+/// splits the triangles of an object (each triangle's scan stays sequential).
+IntraDistanceOutput intra_object_distance_brute_force(const Frame& frame, int threads = 1);
+
+/// A second reference for meshes too large for the brute force (tests on the bunny, the height
+/// field): for each f, every other triangle in order of its box's distance from f's box, exact
+/// tests until that box distance exceeds the best distance found (+ rounding slack). Nothing
+/// shared with the query (no BVH, no bounds, no Stage II); the same pairs, canonical evaluation
+/// and tie-break as the brute force, so its results are bitwise the brute force's (tested).
+IntraDistanceOutput intra_object_distance_sorted_scan(const Frame& frame, int threads = 1);
+
+}  // namespace vproxq

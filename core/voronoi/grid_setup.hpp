@@ -1,0 +1,81 @@
+#pragma once
+// Pieces shared by the inter-object (stage2.cpp) and the intra-object (self_stage2.cpp) Stage II:
+// the grid over the scene, the conservative voxelization of a triangle, and the triangle arrays
+// of a DvdInput.
+#include "core/broad_phase/aabb.hpp"
+#include "core/geometry/triangle_box.hpp"
+#include "core/scene.hpp"
+#include "core/voronoi/discrete_voronoi.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace vproxq {
+
+/// A Stage II grid and the numbers Lemma 2 derives from it.
+struct StageGrid {
+  VoronoiGrid grid;
+  /// Length of the grid box's diagonal: every coordinate relative to the origin (triangle
+  /// corners inside the box, sample points) is at most this in magnitude.
+  double extent = 0;
+  /// Voxelization slack: the SAT test runs in double on coordinates relative to the grid
+  /// origin, of magnitude <= extent; its projections are off by at most a few ulps of it.
+  /// Widening the voxel's half side by kVoxelSlackRel * (extent + cell) (~4.5e6 ulps) makes the
+  /// test conservative: every voxel that the exact triangle touches is marked. A marked voxel
+  /// centre is then within `half` * sqrt(3) of the triangle, which δ accounts for.
+  double voxel_slack = 0;
+  double half = 0;  ///< cell / 2 + voxel_slack
+
+  static constexpr double kVoxelSlackRel = 1e-9;
+
+  /// Cubic cells, `resolution` (>= 1) cells along the longest axis of the non-empty `box`.
+  static StageGrid over(const AABB& box, int resolution) {
+    StageGrid g;
+    const Vec3 ext = box.hi - box.lo;
+    const double longest = std::max(ext.maxCoeff(), 1e-300);
+    g.grid.cell = longest / resolution;
+    g.grid.origin = box.lo;
+    for (int k = 0; k < 3; ++k)
+      g.grid.dims[k] = std::max<std::int32_t>(1, static_cast<std::int32_t>(std::ceil(ext[k] / g.grid.cell)));
+    g.extent = (g.grid.cell * Vec3(g.grid.dims[0], g.grid.dims[1], g.grid.dims[2])).norm();
+    g.voxel_slack = kVoxelSlackRel * (g.extent + g.grid.cell);
+    g.half = 0.5 * g.grid.cell + g.voxel_slack;
+    return g;
+  }
+
+  /// Lemma 2's δ: the farthest a marked voxel centre is from its triangle, plus the backend's
+  /// arithmetic error.
+  double delta(double delta_precision) const { return std::sqrt(3.0) * half + delta_precision; }
+
+  /// Calls visit(linear voxel id) for every voxel that `tri` (absolute coordinates, bounding
+  /// box `box`) touches, conservatively (see voxel_slack), in increasing (z, y, x) order.
+  template <typename Visit>
+  void voxelize(const Triangle& tri, const AABB& box, const Visit& visit) const {
+    Triangle rel = tri;
+    for (auto& p : rel) p -= grid.origin;
+    std::array<std::int32_t, 3> lo{}, hi{};
+    for (int k = 0; k < 3; ++k) {
+      auto cell_of = [&](double x) {
+        return std::clamp<std::int32_t>(static_cast<std::int32_t>(std::floor(x / grid.cell)), 0, grid.dims[k] - 1);
+      };
+      lo[k] = cell_of(box.lo[k] - grid.origin[k] - voxel_slack);
+      hi[k] = cell_of(box.hi[k] - grid.origin[k] + voxel_slack);
+    }
+    for (std::int32_t z = lo[2]; z <= hi[2]; ++z)
+      for (std::int32_t y = lo[1]; y <= hi[1]; ++y)
+        for (std::int32_t x = lo[0]; x <= hi[0]; ++x) {
+          const Vec3 c = grid.cell * Vec3(x + 0.5, y + 0.5, z + 0.5);
+          if (!triangle_box_overlap(rel, c, half)) continue;
+          visit(x + std::int64_t{grid.dims[0]} * (y + std::int64_t{grid.dims[1]} * z));
+        }
+  }
+};
+
+/// Fills in.tri_xyz, in.tri_xyz_d (relative to in.grid.origin) and in.tri_site (object id) with
+/// every triangle of the frame, in object order. Returns the first triangle index of each
+/// object (size objects + 1).
+std::vector<std::int64_t> fill_dvd_triangles(DvdInput& in, const Frame& frame);
+
+}  // namespace vproxq

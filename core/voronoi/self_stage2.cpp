@@ -1,0 +1,162 @@
+#include "core/voronoi/self_stage2.hpp"
+
+#include "core/parallel.hpp"
+#include "core/timer.hpp"
+#include "core/voronoi/bins.hpp"
+#include "core/voronoi/grid_setup.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace vproxq {
+namespace {
+
+// Bands are capped at this many cells: a narrower band only weakens culling, never correctness
+// (a capped value gives D_l = cap - δ, which then simply culls less). Self bands start from the
+// 2-ring bound, which is about one edge length, so the cap rarely binds at the default grid.
+constexpr double kMaxSelfBandCells = 3.0;
+// Bins of this many voxels per side for the backends' triangle lookup.
+constexpr std::int32_t kBinSize = 4;
+
+struct Sample {
+  std::int64_t voxel;
+  std::int32_t triangle;  // index into the DvdInput triangle arrays
+};
+
+}  // namespace
+
+int default_self_grid_resolution(std::int64_t triangles) {
+  // The self bounds cull only when δ (~0.9 cell) is below the distances between neighbouring
+  // non-adjacent triangles, about half an edge length; for a surface of n triangles spanning
+  // the grid an edge is ~ extent / sqrt(n / 2), so the cell must shrink like 1 / sqrt(n).
+  // sqrt(n) cells along the longest axis (cell ~ 0.7 edge), clamped to [32, 512], keeps Stage
+  // II's cost moderate; on the cloth-funnel frame finer grids cull a little more but cost more
+  // than they save (README, "Intra-object distance").
+  const double g = std::sqrt(static_cast<double>(std::max<std::int64_t>(triangles, 1)));
+  return static_cast<int>(std::clamp(std::lround(g), 32L, 512L));
+}
+
+void validate_self_dvd_input(const SelfDvdInput& in) {
+  validate_dvd_input(in.dvd);
+  auto fail = [](const std::string& what) {
+    throw std::invalid_argument("SelfVoronoiBackend::compute: " + what);
+  };
+  const std::size_t tris = in.dvd.tri_site.size();
+  if (in.sample_triangle.size() != in.dvd.voxels.size()) fail("one triangle per sample needed");
+  if (in.tri_vertices.size() != 3 * tris) fail("tri_vertices is not 3 ids per triangle");
+  for (const std::int32_t t : in.sample_triangle)
+    if (t < 0 || static_cast<std::size_t>(t) >= tris) fail("sample_triangle holds an invalid triangle");
+}
+
+SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes,
+                                              const std::vector<std::vector<double>>& ring2_bound,
+                                              SelfVoronoiBackend& backend, int grid_resolution,
+                                              int threads) {
+  Stopwatch sw;
+  SelfVoronoiBounds out;
+  const size_t n = frame.objects.size();
+  out.triangle_upper = ring2_bound;
+  out.triangle_lower.resize(n);
+  std::int64_t total_tris = 0;
+  AABB scene;
+  for (size_t i = 0; i < n; ++i) {
+    out.triangle_lower[i].assign(static_cast<size_t>(frame.objects[i].num_triangles()), -kInfinity);
+    // Objects with fewer than 2 triangles have no non-adjacent pair: nothing to sample.
+    if (frame.objects[i].num_triangles() < 2) continue;
+    total_tris += frame.objects[i].num_triangles();
+    scene.extend(boxes.objects[i]);
+  }
+  if (scene.empty()) return out;
+
+  const int res = grid_resolution > 0 ? grid_resolution : default_self_grid_resolution(total_tris);
+  const StageGrid sg = StageGrid::over(scene, res);
+  out.grid = sg.grid;
+  out.delta_precision = backend.distance_error_bound(sg.extent);
+  out.delta = sg.delta(out.delta_precision);
+  const double slack = rounding_slack(boxes.magnitude);
+  const double band_cap = kMaxSelfBandCells * sg.grid.cell;
+
+  SelfDvdInput in;
+  in.dvd.grid = sg.grid;
+  const std::vector<std::int64_t> tri_base = fill_dvd_triangles(in.dvd, frame);
+  in.tri_vertices.resize(in.dvd.tri_site.size() * 3);
+  for (size_t i = 0; i < n; ++i) {
+    const auto& faces = frame.objects[i].topology->faces;
+    for (size_t t = 0; t < faces.size(); ++t)
+      for (size_t c = 0; c < 3; ++c)
+        in.tri_vertices[3 * (static_cast<size_t>(tri_base[i]) + t) + c] = faces[t][c];
+  }
+
+  // Conservative voxelization: samples per object in parallel, then sorted by (voxel, triangle)
+  // (triangles are numbered in object order, so the result does not depend on threads).
+  std::vector<std::vector<Sample>> hits(n);
+  parallel_for(n, threads, [&](size_t i) {
+    const Object& o = frame.objects[i];
+    if (o.num_triangles() < 2) return;
+    for (Index t = 0; t < o.num_triangles(); ++t) {
+      const auto global = static_cast<std::int32_t>(tri_base[i] + t);
+      sg.voxelize(o.triangle(t), boxes.triangles[i][static_cast<size_t>(t)],
+                  [&](std::int64_t id) { hits[i].push_back({id, global}); });
+    }
+  });
+  std::vector<Sample> samples;
+  for (auto& h : hits) samples.insert(samples.end(), h.begin(), h.end());
+  hits.clear();
+  std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) {
+    return a.voxel != b.voxel ? a.voxel < b.voxel : a.triangle < b.triangle;
+  });
+
+  // Bands: f needs exact values up to its 2-ring bound + δ (+ slack): below that a value can
+  // improve D_u(f), and a capped value then gives D_l(f) = band - δ >= the 2-ring bound, which
+  // culls f from every search whose bound is below its own. Capped at kMaxSelfBandCells cells.
+  std::vector<float> tri_band(in.dvd.tri_site.size());
+  for (size_t i = 0; i < n; ++i)
+    for (size_t t = 0; t < ring2_bound[i].size(); ++t) {
+      const double band = std::min(ring2_bound[i][t] + out.delta + slack, band_cap);
+      // Round the float band up so that it is never below the double band.
+      tri_band[static_cast<size_t>(tri_base[i]) + t] =
+          std::nextafter(static_cast<float>(band), std::numeric_limits<float>::infinity());
+    }
+  in.dvd.voxels.reserve(samples.size());
+  in.dvd.band.reserve(samples.size());
+  in.sample_triangle.reserve(samples.size());
+  for (size_t k = 0; k < samples.size(); ++k) {
+    in.dvd.voxels.push_back(samples[k].voxel);
+    in.dvd.band.push_back(tri_band[static_cast<size_t>(samples[k].triangle)]);
+    in.sample_triangle.push_back(samples[k].triangle);
+    if (k == 0 || samples[k].voxel != samples[k - 1].voxel) ++out.sample_voxels;
+  }
+  out.samples = samples.size();
+  bin_triangles(in.dvd, kBinSize);
+  out.setup_ms = sw.elapsed_ms();
+
+  const SelfDvdOutput dvd = backend.compute(in);
+  out.upload_ms = dvd.upload_ms;
+  out.compute_ms = dvd.compute_ms;
+  out.readback_ms = dvd.readback_ms;
+
+  // Scan: SD~(f) over f's samples. For D_l a value at or past the band only says "at least
+  // band"; for D_u only values below the band are distances to an actual triangle.
+  sw.restart();
+  const size_t tri_count = in.dvd.tri_site.size();
+  std::vector<double> sd_lower(tri_count, kInfinity), sd_upper(tri_count, kInfinity);
+  for (size_t k = 0; k < samples.size(); ++k) {
+    const auto t = static_cast<size_t>(in.sample_triangle[k]);
+    const double v = dvd.dist[k], band = in.dvd.band[k];
+    sd_lower[t] = std::min(sd_lower[t], std::min(v, band));
+    if (v < band) sd_upper[t] = std::min(sd_upper[t], v);
+  }
+  for (size_t i = 0; i < n; ++i)
+    for (size_t t = 0; t < out.triangle_lower[i].size(); ++t) {
+      const size_t g = static_cast<size_t>(tri_base[i]) + t;
+      // Every triangle marks at least one voxel; should one not, it stays uncullable.
+      if (sd_lower[g] != kInfinity) out.triangle_lower[i][t] = sd_lower[g] - out.delta;
+      out.triangle_upper[i][t] = std::min(out.triangle_upper[i][t], sd_upper[g] + out.delta);
+    }
+  out.scan_ms = sw.elapsed_ms();
+  return out;
+}
+
+}  // namespace vproxq

@@ -1,0 +1,83 @@
+// Stage II of the intra-object query on the GPU (paper 5.2.2): at every sample (voxel, triangle
+// f), the distance from the voxel centre to the nearest triangle of f's object that shares no
+// vertex with f (f's 1-ring and f itself are skipped by a 3x3 vertex id comparison, as the
+// paper's GPU discards adjacent features), capped at the sample's band. One invocation per
+// sample. Host side: gl/self_voronoi_backend.{hpp,cpp}; CPU twin: core/voronoi/cpu_self_backend.cpp.
+//
+// Not compiled on its own: the host appends it to shaders/dvd2_gather.comp (whose main() is
+// renamed by a #define), so it shares that shader's storage buffers 0-4, uniforms, distance
+// function, bin search and error bound; only the parts below are new:
+//   binding 5  results           ivec4 per sample of this batch: float bits of the distance
+//                                (band when none below it), nearest triangle (-1 when none), 0, 0
+//   binding 6  sample_triangles  int per sample of this batch: the sample's triangle f
+//   binding 7  triangle_vertices ivec4 per triangle: its 3 object-local vertex ids, 0
+// triangle_info.x (binding 1) is the triangle's object.
+
+layout(std430, binding = 6) readonly buffer SampleTriangles { int sample_triangles[]; };
+layout(std430, binding = 7) readonly buffer TriangleVertices { ivec4 triangle_vertices[]; };
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= sample_count) {
+    return;
+  }
+  uint id = samples[i].x;
+  float band = uintBitsToFloat(samples[i].y);
+  int f = sample_triangles[i];
+  int object = triangle_info[f].x;
+  ivec3 fv = triangle_vertices[f].xyz;
+  uint dx = uint(dims_x);
+  uint dy = uint(dims_y);
+  ivec3 voxel = ivec3(int(id % dx), int((id / dx) % dy), int(id / (dx * dy)));
+  vec3 centre = vec3(voxel) + 0.5;  // in cell units, exact
+  vec3 q = centre * cell;
+
+  // Bins overlapping the box centre -+ band (in cells), widened, clamped: as dvd2_gather.
+  ivec3 last_voxel = ivec3(dims_x, dims_y, dims_z) - 1;
+  float reach = min(band / cell, float(max(dims_x, max(dims_y, dims_z))) + 1.0);
+  vec3 widen = (centre + reach + 1.0) * kBinSearchSlack;
+  ivec3 bin_lo = min(ivec3(max(floor(centre - reach - widen), vec3(0.0))), last_voxel) / bin_size;
+  ivec3 bin_hi = min(ivec3(floor(centre + reach + widen)), last_voxel) / bin_size;
+
+  float best = uintBitsToFloat(0x7F800000u);  // +infinity, squared distance
+  int nearest = kNoIndex;
+  float cutoff = band + prefilter_margin;
+  float cutoff_squared = cutoff * cutoff;
+  for (int bz = bin_lo.z; bz <= bin_hi.z; ++bz) {
+    for (int by = bin_lo.y; by <= bin_hi.y; ++by) {
+      for (int bx = bin_lo.x; bx <= bin_hi.x; ++bx) {
+        ivec3 here = ivec3(bx, by, bz);
+        int b = bx + bin_dims_x * (by + bin_dims_y * bz);
+        int end = bin_offsets[b + 1];
+        for (int j = bin_offsets[b]; j < end; ++j) {
+          int t = bin_triangles[j];
+          ivec4 info = triangle_info[t];
+          if (info.x != object || max(info.yzw, bin_lo) != here) {
+            continue;
+          }
+          ivec3 tv = triangle_vertices[t].xyz;
+          if (any(equal(tv, fv.xxx)) || any(equal(tv, fv.yyy)) || any(equal(tv, fv.zzz))) {
+            continue;  // f itself or its 1-ring
+          }
+          vec3 a = corner(t, 0);
+          vec3 b3 = corner(t, 1);
+          vec3 c = corner(t, 2);
+          vec3 gap = max(max(min(min(a, b3), c) - q, q - max(max(a, b3), c)), vec3(0.0));
+          if (dot(gap, gap) > cutoff_squared) {
+            continue;
+          }
+          float d = point_triangle_distance_squared(q, a, b3, c);
+          if (d < best || (d == best && t < nearest)) {
+            best = d;
+            nearest = t;
+            cutoff = min(band, sqrt(best)) + prefilter_margin;
+            cutoff_squared = cutoff * cutoff;
+          }
+        }
+      }
+    }
+  }
+  float dist = sqrt(best);
+  bool has = nearest != kNoIndex && dist < band;
+  results[i] = ivec4(floatBitsToInt(has ? dist : band), has ? nearest : kNoIndex, 0, 0);
+}

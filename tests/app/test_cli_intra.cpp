@@ -1,0 +1,104 @@
+// End-to-end: the CLI's distance.intra (JSON) and distance/intra (HDF5) equal the library's
+// brute force, with every Stage II backend.
+#include "core/query/intra_distance.hpp"
+#include "io/hdf5_reader.hpp"
+#include "io/scene_source.hpp"
+#include "support/process.hpp"
+#include "support/self_meshes.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+
+namespace vproxq {
+namespace {
+
+namespace fs = std::filesystem;
+using test::quote;
+using test::run_command;
+using test::ScratchDir;
+
+/// Writes a frame as one OBJ with an `o` group per object, 17 significant digits.
+void write_obj_file(const Frame& frame, const fs::path& file) {
+  std::ofstream out(file);
+  out.precision(17);
+  Index base = 1;
+  for (const Object& o : frame.objects) {
+    out << "o " << o.name << "\n";
+    for (const Vec3& p : o.positions) out << "v " << p.x() << " " << p.y() << " " << p.z() << "\n";
+    for (const Face& f : o.topology->faces)
+      out << "f " << f[0] + base << " " << f[1] + base << " " << f[2] + base << "\n";
+    base += o.num_vertices();
+  }
+}
+
+TEST(CliIntra, JsonAndHdf5EqualBruteForceWithEveryBackend) {
+  ScratchDir dir;
+  test::Rng rng(3);
+  Frame made;
+  made.objects.push_back(test::make_folded_sheet(rng, 12, 5, 0.1, 0.04, 0.1, "sheet"));
+  made.objects.push_back(test::make_blob(rng, Vec3(2, 0, 0), 0.8, 1, 0.5, "blob"));
+  made.objects.push_back(test::make_object({{5, 0, 0}, {6, 0, 0}, {5, 1, 0}}, {{0, 1, 2}}, "single"));
+  write_obj_file(made, dir / "scene.obj");
+  // What the CLI will see: the OBJ read back (its own double parsing), not `made`.
+  const Frame frame = SceneSource::open(dir / "scene.obj").load_frame(0);
+  const auto ref = intra_object_distance_brute_force(frame);
+  for (const char* backend : {"off", "cpu", "gpu"}) {
+    SCOPED_TRACE(backend);
+    const fs::path out = dir / backend;
+    const auto r = run_command(std::string(VPROXQ_BINARY) + " " + quote(dir / "scene.obj") + " -o " +
+                               quote(out) + " --quiet --threads 2 --voronoi=" + backend);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream in(out / "results.json");
+    const nlohmann::json j = nlohmann::json::parse(in);
+    const auto& intra = j["frames"][0]["distance"]["intra"];
+    ASSERT_EQ(intra.size(), ref.per_object.size());
+    for (size_t i = 0; i < ref.per_object.size(); ++i) {
+      const auto& e = ref.per_object[i];
+      EXPECT_EQ(intra[i]["object"].get<int>(), static_cast<int>(i));
+      if (!e.has_pair()) {
+        EXPECT_TRUE(intra[i]["distance"].is_null());
+        EXPECT_TRUE(intra[i]["triangles"].is_null());
+        continue;
+      }
+      EXPECT_EQ(intra[i]["distance"].get<double>(), e.distance);
+      EXPECT_EQ(intra[i]["triangles"][0].get<int>(), e.triangles[0]);
+      EXPECT_EQ(intra[i]["triangles"][1].get<int>(), e.triangles[1]);
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(intra[i]["points"][0][c].get<double>(), e.points[0][c]);
+        EXPECT_EQ(intra[i]["points"][1][c].get<double>(), e.points[1][c]);
+      }
+    }
+    EXPECT_GT(j["frames"][0]["stats"]["intra_exact_tests"].get<std::uint64_t>(), 0u);
+    EXPECT_EQ(j["frames"][0]["stats"].contains("self_voronoi"), std::string(backend) != "off");
+
+    // HDF5: the per-triangle table, object-major.
+    const Hdf5Reader h5(out / "results.h5");
+    const std::string table = "/frames/000000/distance/intra";
+    const auto object = h5.int_field(table, "object");
+    const auto triangle = h5.int_field(table, "triangle");
+    const auto nearest = h5.int_field(table, "nearest");
+    const auto distance = h5.double_field(table, "distance");
+    const auto point_a = h5.double_field(table, "point_a");
+    size_t row = 0;
+    for (size_t i = 0; i < ref.per_object.size(); ++i)
+      for (size_t t = 0; t < ref.per_object[i].per_triangle.size(); ++t, ++row) {
+        ASSERT_LT(row, object.size());
+        const auto& e = ref.per_object[i].per_triangle[t];
+        EXPECT_EQ(object[row], static_cast<std::int64_t>(i));
+        EXPECT_EQ(triangle[row], static_cast<std::int64_t>(t));
+        EXPECT_EQ(nearest[row], e.nearest);
+        EXPECT_EQ(distance[row], e.distance);
+        if (e.nearest == kNoIndex) continue;
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_EQ(point_a[3 * row + static_cast<size_t>(c)], e.points[0][c]);
+        }
+      }
+    EXPECT_EQ(row, object.size());
+    EXPECT_EQ(h5.rows("/frames/000000/distance/intra_min"), ref.per_object.size());
+  }
+}
+
+}  // namespace
+}  // namespace vproxq

@@ -1,0 +1,151 @@
+// Intra-object (self) distance: Stage III (AABB-only and with Stage II's bounds) against the
+// all-non-adjacent-pairs brute force, per triangle and bitwise.
+#include "core/mesh/adjacency.hpp"
+#include "core/query/intra_distance.hpp"
+#include "core/voronoi/self_stage2.hpp"
+#include "support/random_scene.hpp"
+#include "support/self_meshes.hpp"
+
+#include <gtest/gtest.h>
+
+namespace vproxq {
+namespace {
+
+using test::expect_same_intra;
+using test::Rng;
+
+Frame frame_of(std::vector<Object> objects) {
+  Frame f;
+  f.objects = std::move(objects);
+  return f;
+}
+
+/// Scenes of every kind the self query must handle, by seed.
+std::vector<std::pair<std::string, Frame>> scenes() {
+  std::vector<std::pair<std::string, Frame>> out;
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    Rng rng(seed);
+    // Blobs with strong jitter (creases, some self-intersections), several objects per frame.
+    Frame blobs;
+    for (int i = 0; i < 3; ++i)
+      blobs.objects.push_back(test::make_blob(rng, Vec3(3.0 * i, 0, 0), 1.0, 2, 0.5, "blob"));
+    out.emplace_back("blobs seed " + std::to_string(seed), std::move(blobs));
+    // A soup: no shared vertices, every pair non-adjacent, many intersections.
+    out.emplace_back("soup seed " + std::to_string(seed),
+                     frame_of({test::make_soup(rng, Vec3::Zero(), 0.5, 0.3, 60, "soup")}));
+    // Folded sheets, the gap from well below to above the cell size.
+    const double gap = 0.02 * std::pow(4.0, static_cast<double>(seed - 1));
+    out.emplace_back("folded sheet gap " + std::to_string(gap),
+                     frame_of({test::make_folded_sheet(rng, 16, 6, 0.1, gap, 0.1)}));
+    out.emplace_back("irregular seed " + std::to_string(seed),
+                     frame_of({test::make_irregular_mesh(rng)}));
+  }
+  return out;
+}
+
+TEST(IntraDistance, EqualsBruteForceOnAllScenesAndThreadCounts) {
+  for (const auto& [name, frame] : scenes()) {
+    const auto ref = intra_object_distance_brute_force(frame);
+    for (int threads : {1, 3}) {
+      const auto got = intra_object_distance(frame, {threads});
+      expect_same_intra(got, ref, name + ", threads " + std::to_string(threads));
+      EXPECT_LE(got.counters.intra_exact_tests, ref.counters.intra_exact_tests) << name;
+    }
+  }
+}
+
+TEST(IntraDistance, SortedScanReferenceEqualsBruteForce) {
+  for (const auto& [name, frame] : scenes())
+    expect_same_intra(intra_object_distance_sorted_scan(frame, 2),
+                      intra_object_distance_brute_force(frame), name + ", sorted scan");
+}
+
+TEST(IntraDistance, Ring2BoundIsAnUpperBound) {
+  for (const auto& [name, frame] : scenes()) {
+    const auto ref = intra_object_distance_brute_force(frame);
+    const auto bound = ring2_upper_bounds(frame, 2);
+    for (size_t i = 0; i < frame.objects.size(); ++i) {
+      const Adjacency& adj = adjacency(*frame.objects[i].topology);
+      for (Index t = 0; t < frame.objects[i].num_triangles(); ++t) {
+        const double u = bound[i][static_cast<size_t>(t)];
+        EXPECT_GE(u, ref.per_object[i].per_triangle[static_cast<size_t>(t)].distance) << name;
+        EXPECT_EQ(u == kInfinity, adj.ring2(t).empty()) << name << " triangle " << t;
+      }
+    }
+  }
+}
+
+TEST(IntraDistance, IrregularMeshExclusionsAreByVertexSharing) {
+  Rng rng(7);
+  const Frame frame = frame_of({test::make_irregular_mesh(rng)});
+  const Object& o = frame.objects[0];
+  const auto got = intra_object_distance(frame, {2});
+  const auto& table = got.per_object[0].per_triangle;
+  const auto& faces = o.topology->faces;
+  bool some_zero = false;
+  for (size_t t = 0; t < table.size(); ++t) {
+    if (table[t].nearest == kNoIndex) {
+      // Only when every other triangle shares a vertex with t.
+      for (size_t g = 0; g < faces.size(); ++g)
+        if (g != t) {
+          EXPECT_TRUE(Adjacency::share_vertex(faces[t], faces[g])) << t << " " << g;
+        }
+      continue;
+    }
+    EXPECT_FALSE(Adjacency::share_vertex(faces[t], faces[static_cast<size_t>(table[t].nearest)]));
+    some_zero = some_zero || table[t].distance == 0;
+  }
+  EXPECT_TRUE(some_zero);  // the crossing triangle intersects the sheet: reported as 0
+  EXPECT_EQ(got.per_object[0].distance, 0.0);
+}
+
+TEST(IntraDistance, ObjectsWithoutNonAdjacentPairs) {
+  // One triangle; two triangles sharing an edge; a fan around one vertex: no pair qualifies.
+  const Frame frame = frame_of(
+      {test::make_object({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}}, "one"),
+       test::make_object({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}}, {{0, 1, 2}, {1, 3, 2}}, "two"),
+       test::make_object({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}},
+                         {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 1}}, "fan"),
+       test::make_object({}, {}, "empty")});
+  const auto got = intra_object_distance(frame, {2});
+  const auto ref = intra_object_distance_brute_force(frame);
+  expect_same_intra(got, ref, "no pairs");
+  for (const auto& o : got.per_object) {
+    EXPECT_FALSE(o.has_pair());
+    EXPECT_EQ(o.distance, kInfinity);
+    for (const auto& t : o.per_triangle) EXPECT_EQ(t.nearest, kNoIndex);
+  }
+}
+
+// Lemma 2 for the self query: D_l(f) <= SD(f) <= D_u(f) for every triangle, at coarse and fine
+// grids; and Stage III with these bounds still equals the brute force.
+TEST(IntraStage2, CpuBoundsHoldAndResultsEqualBruteForce) {
+  auto backend = make_cpu_self_voronoi_backend(2);
+  for (const auto& [name, frame] : scenes()) {
+    const auto ref = intra_object_distance_brute_force(frame);
+    const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
+    const auto ring2 = ring2_upper_bounds(frame, 2);
+    std::uint64_t exact_off = intra_object_distance(frame, boxes, ring2, {2}).counters.intra_exact_tests;
+    for (int grid : {8, 24, 64}) {
+      SCOPED_TRACE(name + ", grid " + std::to_string(grid));
+      const SelfVoronoiBounds vb = compute_self_voronoi_bounds(frame, boxes, ring2, *backend, grid, 2);
+      EXPECT_GT(vb.delta, 0.0);
+      for (size_t i = 0; i < frame.objects.size(); ++i)
+        for (size_t t = 0; t < ref.per_object[i].per_triangle.size(); ++t) {
+          const double sd = ref.per_object[i].per_triangle[t].distance;
+          ASSERT_LE(vb.triangle_lower[i][t], sd) << "object " << i << " triangle " << t;
+          ASSERT_GE(vb.triangle_upper[i][t], sd) << "object " << i << " triangle " << t;
+          ASSERT_LE(vb.triangle_upper[i][t], ring2[i][t]);
+        }
+      for (int threads : {1, 3}) {
+        IntraDistanceOptions opts{threads, &vb};
+        const auto got = intra_object_distance(frame, boxes, ring2, opts);
+        expect_same_intra(got, ref, "voronoi cpu, threads " + std::to_string(threads));
+        EXPECT_LE(got.counters.intra_exact_tests, exact_off);
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace vproxq

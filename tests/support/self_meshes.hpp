@@ -1,0 +1,125 @@
+#pragma once
+// Meshes for the intra-object (self) proximity tests: a sheet folded over onto itself, and an
+// irregular mesh with boundary, non-manifold edges, duplicate and degenerate triangles and
+// isolated vertices.
+#include "core/query/intra_distance.hpp"
+#include "core/scene.hpp"
+#include "support/random_scene.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+
+namespace vproxq::test {
+
+inline Object make_object(std::vector<Vec3> positions, std::vector<Face> faces, const std::string& name) {
+  auto topo = std::make_shared<Topology>();
+  topo->num_vertices = static_cast<Index>(positions.size());
+  topo->faces = std::move(faces);
+  Object o;
+  o.name = name;
+  o.topology = std::move(topo);
+  o.positions = std::move(positions);
+  return o;
+}
+
+/// A regular nx x ny grid sheet of side `cell` (two triangles per square, diagonals alternating)
+/// folded over onto itself around a half cylinder of radius gap / 2 at arc length `fold`: the
+/// two layers face each other `gap` apart, so nearest non-adjacent triangles are across the
+/// fold for gap below ~cell and within the layer otherwise. `jitter` (relative to cell) moves
+/// every vertex randomly.
+inline Object make_folded_sheet(Rng& rng, int nx, int ny, double cell, double gap, double jitter,
+                                const std::string& name = "sheet") {
+  const double r = gap / 2;
+  const double fold = 0.5 * (nx * cell - M_PI * r);
+  std::vector<Vec3> v;
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) {
+      const double s = i * cell, y = j * cell;
+      Vec3 p;
+      if (s <= fold) {
+        p = Vec3(s, y, 0);
+      } else if (s <= fold + M_PI * r) {
+        const double t = (s - fold) / r;
+        p = Vec3(fold + r * std::sin(t), y, r - r * std::cos(t));
+      } else {
+        p = Vec3(fold - (s - fold - M_PI * r), y, 2 * r);
+      }
+      p += cell * jitter * Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+      v.push_back(p);
+    }
+  std::vector<Face> f;
+  auto id = [&](int i, int j) { return static_cast<Index>(j * (nx + 1) + i); };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      if ((i + j) % 2 == 0) {
+        f.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+        f.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+      } else {
+        f.push_back({id(i, j), id(i + 1, j), id(i, j + 1)});
+        f.push_back({id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+      }
+    }
+  return make_object(std::move(v), std::move(f), name);
+}
+
+/// A small open sheet (boundary edges) plus: three fins on one edge (non-manifold), a duplicate
+/// triangle, a triangle with a repeated vertex, a zero-area (collinear) triangle, a triangle
+/// crossing the sheet (intersecting non-adjacent pairs), and isolated vertices used by no face.
+inline Object make_irregular_mesh(Rng& rng, const std::string& name = "irregular") {
+  Object o = make_folded_sheet(rng, 6, 5, 0.2, 10.0, 0.15, name);  // gap 10: effectively flat
+  auto topo = std::make_shared<Topology>(*o.topology);
+  auto& v = o.positions;
+  auto& f = topo->faces;
+  auto add = [&](const Vec3& p) {
+    v.push_back(p);
+    return static_cast<Index>(v.size() - 1);
+  };
+  // Non-manifold: three more triangles on the edge (0, 1) of the sheet.
+  const Index a = f[0][0], b = f[0][1];
+  for (int k = 0; k < 3; ++k) f.push_back({a, b, add(Vec3(0.1, -0.1 - 0.05 * k, 0.1 + 0.1 * k))});
+  const Face dup = f[7], rep = f[12];
+  f.push_back(dup);                       // duplicate triangle
+  f.push_back({rep[0], rep[0], rep[2]});  // repeated vertex
+  const Index c0 = add(Vec3(0.3, 0.3, 0.05)), c1 = add(Vec3(0.5, 0.5, 0.05));
+  f.push_back({c0, c1, add(Vec3(0.7, 0.7, 0.05))});  // collinear: zero area
+  f.push_back({add(Vec3(0.45, 0.35, -0.2)), add(Vec3(0.55, 0.4, 0.2)), add(Vec3(0.5, 0.6, 0.1))});
+  add(Vec3(0.4, 0.4, 0.01));  // isolated vertices
+  add(Vec3(5, 5, 5));
+  topo->num_vertices = static_cast<Index>(v.size());
+  o.topology = std::move(topo);
+  return o;
+}
+
+/// Per-triangle tables and minima must be bitwise equal: pipeline and brute force evaluate
+/// the same pairs in the same canonical order.
+inline void expect_same_intra(const IntraDistanceOutput& got, const IntraDistanceOutput& ref,
+                              const std::string& what) {
+  ASSERT_EQ(got.per_object.size(), ref.per_object.size()) << what;
+  for (size_t i = 0; i < ref.per_object.size(); ++i) {
+    const auto& g = got.per_object[i];
+    const auto& r = ref.per_object[i];
+    SCOPED_TRACE(what + ", object " + std::to_string(i));
+    EXPECT_EQ(g.object, r.object);
+    EXPECT_EQ(g.distance, r.distance);
+    EXPECT_EQ(g.triangles, r.triangles);
+    EXPECT_EQ(g.points[0], r.points[0]);
+    EXPECT_EQ(g.points[1], r.points[1]);
+    ASSERT_EQ(g.per_triangle.size(), r.per_triangle.size());
+    int mismatches = 0;
+    for (size_t t = 0; t < r.per_triangle.size(); ++t) {
+      const auto& a = g.per_triangle[t];
+      const auto& b = r.per_triangle[t];
+      const bool same = a.nearest == b.nearest && a.distance == b.distance &&
+                        a.points[0] == b.points[0] && a.points[1] == b.points[1] && a.kind == b.kind;
+      if (!same && ++mismatches <= 5)
+        ADD_FAILURE() << "triangle " << t << ": got " << a.nearest << " at " << a.distance
+                      << ", brute force " << b.nearest << " at " << b.distance;
+    }
+    EXPECT_EQ(mismatches, 0);
+  }
+}
+
+}  // namespace vproxq::test
