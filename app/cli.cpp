@@ -150,7 +150,7 @@ int cli_main(int argc, char** argv) {
       ->required();
   app.add_option("--queries", config.queries,
                  "comma-separated queries to run (default: the scene's \"queries\", else "
-                 "distance). Valid: distance")
+                 "distance). Valid: distance, ccd")
       ->delimiter(',');
   app.add_option("-o,--output", config.output_dir,
                  "write OUT/results.json and OUT/results.h5 (default: print a summary)");

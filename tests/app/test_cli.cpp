@@ -90,7 +90,7 @@ TEST(Cli, UsageErrors) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("unknown query 'bogus'"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("valid queries: distance"), std::string::npos) << r.output;
-  r = vproxq(scene + " --queries=ccd");
+  r = vproxq(scene + " --queries=pd");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("not implemented"), std::string::npos) << r.output;
   r = vproxq(scene + " --voronoi=sometimes");
