@@ -38,7 +38,7 @@ inline constexpr double kCcdRelativeTolerance = 1e-6;
 /// smallest lower t of the boxes left and the hits so far (conservative). Degenerate
 /// near-misses (parallel sliding just outside δ) are what can reach it. A box that can be
 /// neither excluded nor split (sides of 2^-50) is counted as a hit the same way.
-inline constexpr std::uint32_t kCcdMaxBoxes = 1u << 18;
+inline constexpr std::uint32_t kCcdMaxBoxes = 1u << 17;
 
 struct CcdResult {
   bool collides = false;
