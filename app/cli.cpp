@@ -1,5 +1,6 @@
 #include "app/cli.hpp"
 
+#include "app/check_ccd.hpp"
 #include "app/config.hpp"
 #include "core/errors.hpp"
 #include "io/result_diff.hpp"
@@ -20,7 +21,8 @@ const char* kDescription =
     "For every frame of SCENE (a scene.json or a single mesh file) and every object: the\n"
     "nearest other object, the separation distance and the closest triangle pair.\n"
     "Exit codes: 0 ok, 2 usage error, 3 input error, 4 runtime error.\n"
-    "See also: vproxq diff A.json B.json (compare two result files).";
+    "See also: vproxq diff A.json B.json (compare two result files),\n"
+    "          vproxq check-ccd FILE.csv --type vf|ee (check CCD on ground-truth queries).";
 
 /// Parses "A:B", "A:", ":B" or "A" (a single frame) into a FrameRange.
 FrameRange parse_frame_range(const std::string& text) {
@@ -114,10 +116,32 @@ int diff_main(int argc, char** argv) {
   });
 }
 
+int check_ccd_main(int argc, char** argv) {
+  CLI::App app{"vproxq check-ccd: run the elementary CCD test on every query of a ground-truth "
+               "file (8 rows of rational coordinates per query, last column the truth) and "
+               "count the disagreements.\nExit codes: 0 no false negative, 1 false negatives "
+               "found, 2 usage error, 3 input error.", "vproxq check-ccd"};
+  std::string file, type;
+  app.add_option("FILE", file, "query file (.csv)")->required();
+  app.add_option("--type", type, "vf (vertex-face) or ee (edge-edge)")
+      ->required()
+      ->check(CLI::IsMember({"vf", "ee"}));
+  bool done = false;
+  const int code = parse_or_exit(app, argc, argv, done);
+  if (done) return code;
+  return guarded([&] {
+    const CheckCcdSummary s = check_ccd_file(file, type);
+    std::printf("%s\n", format_check_ccd_summary(s).c_str());
+    return s.false_negatives > 0 ? exit_code::kDifferent : exit_code::kOk;
+  });
+}
+
 }  // namespace
 
 int cli_main(int argc, char** argv) {
   if (argc >= 2 && std::strcmp(argv[1], "diff") == 0) return diff_main(argc - 1, argv + 1);
+  if (argc >= 2 && std::strcmp(argv[1], "check-ccd") == 0)
+    return check_ccd_main(argc - 1, argv + 1);
 
   CLI::App app{kDescription, "vproxq"};
   Config config;
@@ -126,7 +150,7 @@ int cli_main(int argc, char** argv) {
       ->required();
   app.add_option("--queries", config.queries,
                  "comma-separated queries to run (default: the scene's \"queries\", else "
-                 "distance). Valid: distance")
+                 "distance). Valid: distance, ccd")
       ->delimiter(',');
   app.add_option("-o,--output", config.output_dir,
                  "write OUT/results.json and OUT/results.h5 (default: print a summary)");

@@ -2,12 +2,14 @@
 #include "app/progress.hpp"
 #include "core/errors.hpp"
 #include "core/parallel.hpp"
+#include "core/query/ccd.hpp"
 #include "core/query/inter_distance.hpp"
 #include "core/query/intersecting_pairs.hpp"
 #include "core/query/penetration_depth.hpp"
 #include "core/query/intra_distance.hpp"
 #include "core/timer.hpp"
 #include "core/voronoi/self_stage2.hpp"
+#include "core/voronoi/ccd_stage2.hpp"
 #include "core/voronoi/stage2.hpp"
 #include "gl/egl_context.hpp"
 #include "gl/self_voronoi_backend.hpp"
@@ -23,17 +25,12 @@
 namespace vproxq {
 namespace {
 
-/// Queries in canonical order with their state in this version.
-struct QueryName {
-  const char* name;
-  bool implemented;
-};
-constexpr QueryName kQueries[] = {{"distance", true}, {"ccd", false}, {"pd", true}};
+/// Queries in canonical order.
+constexpr const char* kQueries[] = {"distance", "ccd", "pd"};
 
 std::string valid_queries() {
   std::string s;
-  for (const auto& q : kQueries)
-    if (q.implemented) s += (s.empty() ? "" : ", ") + std::string(q.name);
+  for (const char* q : kQueries) s += (s.empty() ? "" : ", ") + std::string(q);
   return s;
 }
 
@@ -42,20 +39,25 @@ std::vector<std::string> canonical_queries(const std::vector<std::string>& reque
                                            const char* origin) {
   for (const auto& r : requested) {
     const auto* q = std::find_if(std::begin(kQueries), std::end(kQueries),
-                                 [&](const QueryName& k) { return r == k.name; });
+                                 [&](const char* k) { return r == k; });
     if (q == std::end(kQueries))
       throw UsageError(std::string(origin) + ": unknown query '" + r +
                        "'; valid queries: " + valid_queries());
-    if (!q->implemented)
-      throw UsageError(std::string(origin) + ": query '" + r +
-                       "' is not implemented in this version; valid queries: " + valid_queries());
   }
   std::vector<std::string> out;
-  for (const auto& q : kQueries)
-    if (std::find(requested.begin(), requested.end(), q.name) != requested.end())
-      out.emplace_back(q.name);
+  for (const char* q : kQueries)
+    if (std::find(requested.begin(), requested.end(), q) != requested.end()) out.emplace_back(q);
   if (out.empty()) throw UsageError(std::string(origin) + ": no query given; valid queries: " + valid_queries());
   return out;
+}
+
+void print_ccd_summary(const CcdStepResult& c) {
+  std::printf("  ccd -> frame %d: %zu vertex-face and %zu edge-edge pairs collide\n", c.to_frame,
+              c.vf.size(), c.ee.size());
+  for (const auto& p : c.pairs)
+    std::printf("  ccd objects %4d %4d  earliest toi %.17g  primitive pairs %llu\n", p.objects[0],
+                p.objects[1], p.toi, static_cast<unsigned long long>(p.primitive_pairs));
+  for (const auto& s : c.skipped) std::printf("  ccd skipped object %d: %s\n", s.object, s.reason.c_str());
 }
 
 void print_summary(const FrameResult& r) {
@@ -72,6 +74,7 @@ void print_summary(const FrameResult& r) {
       else
         std::printf("  pd %d-%d: %s\n", p.objects[0], p.objects[1], pd_status_name(p.status));
     }
+  if (r.ccd) print_ccd_summary(*r.ccd);
   if (!r.inter) return;
   for (const auto& d : *r.inter) {
     const auto& name = r.objects[static_cast<std::size_t>(d.object)].name;
@@ -210,13 +213,21 @@ void run(const Config& config) {
 
   const bool want_distance = std::find(queries.begin(), queries.end(), "distance") != queries.end();
   const bool want_pd = std::find(queries.begin(), queries.end(), "pd") != queries.end();
+  const bool want_ccd = std::find(queries.begin(), queries.end(), "ccd") != queries.end();
+  // CCD of frame k covers the step k -> k+1 whenever the scene has frame k+1 (also past the
+  // end of --frames); that frame is loaded once and reused as the next frame of the loop.
+  std::optional<Frame> next_frame;
   Progress progress(info.frame_count, !config.quiet);
   for (long k = first; k < last; ++k) {
     Stopwatch total;
     FrameResult result;
     result.frame = static_cast<int>(k);
     Stopwatch sw;
-    const Frame frame = scene.load_frame(static_cast<std::size_t>(k));
+    const Frame frame = next_frame && next_frame->index == k
+                            ? std::move(*next_frame)
+                            : scene.load_frame(static_cast<std::size_t>(k));
+    next_frame.reset();
+    if (want_ccd && k + 1 < count) next_frame = scene.load_frame(static_cast<std::size_t>(k + 1));
     result.time_ms.load = sw.elapsed_ms();
     result.files = frame.files;
     for (std::size_t i = 0; i < frame.objects.size(); ++i) {
@@ -263,6 +274,27 @@ void run(const Config& config) {
       if (want_pd) result.pd = penetration_depth(frame, boxes, ip.pairs, {info.threads}).pairs;
       result.intersecting_pairs = std::move(ip.pairs);
       result.time_ms.exact += sw.elapsed_ms();
+    }
+    if (next_frame) {
+      // Stage II for CCD runs the same host code for cpu and gpu in this version (README).
+      sw.restart();
+      const CcdSweep sweep = CcdSweep::compute(frame, *next_frame, info.threads);
+      const double sweep_ms = sw.elapsed_ms();
+      std::optional<CcdVoxelCulling> voxels;
+      double voxel_ms = 0;
+      if (voronoi.backend) {
+        sw.restart();
+        voxels.emplace(frame, *next_frame, sweep, grid, info.threads);
+        voxel_ms = sw.elapsed_ms();
+      }
+      CcdStepResult c = continuous_collisions(frame, *next_frame, sweep,
+                                              CcdOptions{info.threads, voxels ? &*voxels : nullptr});
+      c.aabb_ms += sweep_ms;
+      c.voronoi_ms = voxel_ms;
+      result.time_ms.aabb += c.aabb_ms;
+      result.time_ms.voronoi += c.voronoi_ms;
+      result.time_ms.exact += c.exact_ms;
+      result.ccd = std::move(c);
     }
     result.time_ms.total = total.elapsed_ms();
     if (writer) {

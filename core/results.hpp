@@ -142,6 +142,61 @@ struct PenetrationDepth {
   std::array<std::vector<Index>, 2> overlapping_triangles;
 };
 
+/// CCD (paper 3.2, 5.3): a vertex–face pair that collides between frame k and k+1. Ids index
+/// each object's own vertex and face arrays (file order).
+struct CcdVertexFace {
+  Index object_v = kNoIndex;
+  Index vertex = kNoIndex;
+  Index object_f = kNoIndex;
+  Index face = kNoIndex;
+  double toi = 1;  ///< earliest time of impact in [0, 1] (a lower bound, see geometry/ccd.hpp)
+};
+
+/// CCD: an edge–edge pair that collides; edges as vertex pairs (a < b), the edge with the
+/// smaller (object, edge id) first.
+struct CcdEdgeEdge {
+  Index object_a = kNoIndex;
+  std::array<Index, 2> edge_a{kNoIndex, kNoIndex};
+  Index object_b = kNoIndex;
+  std::array<Index, 2> edge_b{kNoIndex, kNoIndex};
+  double toi = 1;
+};
+
+/// CCD per object pair (objects[0] <= objects[1]; equal for self-collisions).
+struct CcdObjectPair {
+  std::array<Index, 2> objects{kNoIndex, kNoIndex};
+  double toi = 1;                    ///< earliest TOI over its colliding primitive pairs
+  std::uint64_t primitive_pairs = 0;  ///< colliding vertex–face plus edge–edge pairs
+};
+
+/// An object left out of CCD for a step, and why (topology change, no counterpart).
+struct CcdSkipped {
+  Index object = kNoIndex;
+  std::string reason;
+};
+
+struct CcdCounters {
+  std::uint64_t object_pairs = 0;     ///< object pairs (i <= j) whose swept boxes overlap
+  std::uint64_t triangle_pairs = 0;   ///< candidate triangle pairs after culling
+  std::uint64_t vf_tests = 0;         ///< elementary vertex–face tests run
+  std::uint64_t ee_tests = 0;         ///< elementary edge–edge tests run
+  std::uint64_t limit_hits = 0;       ///< tests reported at the kernel's box limit
+  std::uint64_t culled_triangles = 0;  ///< triangles dropped by Stage II (inter-object)
+  std::uint64_t elementary_tests() const { return vf_tests + ee_tests; }
+};
+
+/// The CCD step from this frame to `to_frame`, sorted canonically: vf by (object_v, vertex,
+/// object_f, face), ee by (object_a, edge_a, object_b, edge_b), pairs by objects.
+struct CcdStepResult {
+  int to_frame = 0;
+  std::vector<CcdSkipped> skipped;
+  std::vector<CcdObjectPair> pairs;
+  std::vector<CcdVertexFace> vf;
+  std::vector<CcdEdgeEdge> ee;
+  CcdCounters counters;
+  double aabb_ms = 0, voronoi_ms = 0, exact_ms = 0;
+};
+
 struct ObjectInfo {
   Index id = 0;
   std::string name;
@@ -164,6 +219,8 @@ struct FrameResult {
   StageTimes time_ms;
   std::optional<VoronoiFrameStats> voronoi;
   std::optional<VoronoiFrameStats> self_voronoi;  ///< the intra-object query's Stage II
+  /// Set when "ccd" ran and the scene has a next frame (absent on its last frame).
+  std::optional<CcdStepResult> ccd;
 };
 
 /// What a run was asked and how it ran; written once at the top of each output file.

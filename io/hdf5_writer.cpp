@@ -64,6 +64,32 @@ struct IntraRow {
   std::uint8_t kind;  // field "case"
 };
 
+// CCD rows (ccd/vf, ccd/ee, ccd/pairs).
+struct CcdVfRow {
+  std::int32_t object_v;
+  std::int32_t vertex;
+  std::int32_t object_f;
+  std::int32_t face;
+  double toi;
+};
+
+struct CcdEeRow {
+  std::int32_t object_a;
+  std::int32_t a0;
+  std::int32_t a1;
+  std::int32_t object_b;
+  std::int32_t b0;
+  std::int32_t b1;
+  double toi;
+};
+
+struct CcdPairRow {
+  std::int32_t object_a;
+  std::int32_t object_b;
+  double toi;
+  std::uint64_t primitive_pairs;
+};
+
 // File codes of TriangleDistanceCase, fixed by the file format (not by the enum's order).
 std::uint8_t case_code(TriangleDistanceCase kind) {
   switch (kind) {
@@ -106,6 +132,8 @@ struct Hdf5ResultWriter::Impl {
   Handle vertex_feature_mem_type, vertex_feature_file_type;
   Handle triangle_feature_mem_type, triangle_feature_file_type;
   Handle intra_mem_type, intra_file_type;
+  Handle ccd_vf_mem_type, ccd_vf_file_type, ccd_ee_mem_type, ccd_ee_file_type;
+  Handle ccd_pair_mem_type, ccd_pair_file_type;
   Handle transfer;        ///< dataset transfer list, its buffer sized to each write
   Handle group_creation;  ///< keeps up to kCompactAttributes attributes in the object header
 
@@ -285,6 +313,30 @@ struct Hdf5ResultWriter::Impl {
     write_dataset(g.get(), pd_where, "overlapping_triangles", triangle_feature_file_type.get(),
                   triangle_feature_mem_type.get(), triangles.size(), triangles.data());
     close_checked(g, "H5Gclose", pd_where);
+  }
+
+  void build_ccd_types() {
+    const hid_t i32 = H5T_NATIVE_INT32, i32le = H5T_STD_I32LE;
+    build_compound({{"object_v", offsetof(CcdVfRow, object_v), i32, i32le},
+                    {"vertex", offsetof(CcdVfRow, vertex), i32, i32le},
+                    {"object_f", offsetof(CcdVfRow, object_f), i32, i32le},
+                    {"face", offsetof(CcdVfRow, face), i32, i32le},
+                    {"toi", offsetof(CcdVfRow, toi), H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE}},
+                   sizeof(CcdVfRow), ccd_vf_mem_type, ccd_vf_file_type);
+    build_compound({{"object_a", offsetof(CcdEeRow, object_a), i32, i32le},
+                    {"a0", offsetof(CcdEeRow, a0), i32, i32le},
+                    {"a1", offsetof(CcdEeRow, a1), i32, i32le},
+                    {"object_b", offsetof(CcdEeRow, object_b), i32, i32le},
+                    {"b0", offsetof(CcdEeRow, b0), i32, i32le},
+                    {"b1", offsetof(CcdEeRow, b1), i32, i32le},
+                    {"toi", offsetof(CcdEeRow, toi), H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE}},
+                   sizeof(CcdEeRow), ccd_ee_mem_type, ccd_ee_file_type);
+    build_compound({{"object_a", offsetof(CcdPairRow, object_a), i32, i32le},
+                    {"object_b", offsetof(CcdPairRow, object_b), i32, i32le},
+                    {"toi", offsetof(CcdPairRow, toi), H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE},
+                    {"primitive_pairs", offsetof(CcdPairRow, primitive_pairs), H5T_NATIVE_UINT64,
+                     H5T_STD_U64LE}},
+                   sizeof(CcdPairRow), ccd_pair_mem_type, ccd_pair_file_type);
   }
 
   void write_attribute(hid_t owner, const std::string& owner_name, const char* name,
@@ -473,6 +525,52 @@ struct Hdf5ResultWriter::Impl {
     close_checked(distance, "H5Gclose", dist_where);
   }
 
+  // Group ccd/ of a frame: vf, ee, pairs, skipped_objects + skipped_reasons; attributes
+  // to_frame and the counters and times of the step.
+  void write_ccd(hid_t group, const std::string& where, const CcdStepResult& c) const {
+    const std::string ccd_where = where + "/ccd";
+    Handle ccd = create_group(group, "ccd", ccd_where);
+    const hid_t g = ccd.get();
+    std::vector<CcdVfRow> vf;
+    vf.reserve(c.vf.size());
+    for (const CcdVertexFace& h : c.vf) vf.push_back({h.object_v, h.vertex, h.object_f, h.face, h.toi});
+    write_dataset(g, ccd_where, "vf", ccd_vf_file_type.get(), ccd_vf_mem_type.get(), vf.size(), vf.data());
+    std::vector<CcdEeRow> ee;
+    ee.reserve(c.ee.size());
+    for (const CcdEdgeEdge& h : c.ee)
+      ee.push_back({h.object_a, h.edge_a[0], h.edge_a[1], h.object_b, h.edge_b[0], h.edge_b[1], h.toi});
+    write_dataset(g, ccd_where, "ee", ccd_ee_file_type.get(), ccd_ee_mem_type.get(), ee.size(), ee.data());
+    std::vector<CcdPairRow> pairs;
+    pairs.reserve(c.pairs.size());
+    for (const CcdObjectPair& p : c.pairs)
+      pairs.push_back({p.objects[0], p.objects[1], p.toi, p.primitive_pairs});
+    write_dataset(g, ccd_where, "pairs", ccd_pair_file_type.get(), ccd_pair_mem_type.get(),
+                  pairs.size(), pairs.data());
+    std::vector<std::int32_t> skipped;
+    std::vector<const char*> reasons;
+    for (const CcdSkipped& s : c.skipped) {
+      skipped.push_back(s.object);
+      reasons.push_back(s.reason.c_str());
+    }
+    write_dataset(g, ccd_where, "skipped_objects", H5T_STD_I32LE, H5T_NATIVE_INT32, skipped.size(),
+                  skipped.data());
+    write_dataset(g, ccd_where, "skipped_reasons", string_type.get(), string_type.get(),
+                  reasons.size(), reasons.data());
+    const CcdCounters& k = c.counters;
+    write_attribute(g, ccd_where, "to_frame", std::int32_t{c.to_frame});
+    write_attribute(g, ccd_where, "elementary_tests", std::uint64_t{k.elementary_tests()});
+    write_attribute(g, ccd_where, "vf_tests", std::uint64_t{k.vf_tests});
+    write_attribute(g, ccd_where, "ee_tests", std::uint64_t{k.ee_tests});
+    write_attribute(g, ccd_where, "object_pairs", std::uint64_t{k.object_pairs});
+    write_attribute(g, ccd_where, "triangle_pairs", std::uint64_t{k.triangle_pairs});
+    write_attribute(g, ccd_where, "culled_triangles", std::uint64_t{k.culled_triangles});
+    write_attribute(g, ccd_where, "limit_hits", std::uint64_t{k.limit_hits});
+    write_attribute(g, ccd_where, "time_ms_aabb", c.aabb_ms);
+    write_attribute(g, ccd_where, "time_ms_voronoi", c.voronoi_ms);
+    write_attribute(g, ccd_where, "time_ms_exact", c.exact_ms);
+    close_checked(ccd, "H5Gclose", ccd_where);
+  }
+
   void write_stats(hid_t group, const std::string& where, const FrameResult& frame,
                    double write_ms) const {
     const std::string stats_where = where + "/stats";
@@ -531,6 +629,7 @@ Hdf5ResultWriter::Hdf5ResultWriter(const std::filesystem::path& file, const RunI
   Impl& m = *impl_;
   m.path = file.string();
   m.build_types();
+  m.build_ccd_types();
   m.build_property_lists();
   // The HDF5 1.8 file format (read by every HDF5 since 1.8, h5py and h5dump included): a
   // small group keeps its links in its object header instead of a B-tree and heap of its
@@ -573,6 +672,7 @@ double Hdf5ResultWriter::write_frame(const FrameResult& frame,
   if (frame.intersecting_pairs) m.write_intersecting_pairs(group.get(), where, *frame.intersecting_pairs);
   if (frame.pd) m.write_pd(group.get(), where, *frame.pd);
   if (frame.intra) m.write_intra(group.get(), where, *frame.intra);
+  if (frame.ccd) m.write_ccd(group.get(), where, *frame.ccd);
 
   const double write_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started)

@@ -75,6 +75,36 @@ Json voronoi_stats_json(const VoronoiFrameStats& v) {
   return vj;
 }
 
+Json ccd_json(const CcdStepResult& c) {
+  Json r;
+  r["to_frame"] = c.to_frame;
+  Json skipped = Json::array();
+  for (const CcdSkipped& s : c.skipped) skipped.push_back({{"object", s.object}, {"reason", s.reason}});
+  r["skipped"] = std::move(skipped);
+  Json pairs = Json::array();
+  for (const CcdObjectPair& p : c.pairs)
+    pairs.push_back({{"objects", {p.objects[0], p.objects[1]}}, {"toi", p.toi},
+                     {"primitive_pairs", p.primitive_pairs}});
+  r["pairs"] = std::move(pairs);
+  return r;
+}
+
+Json ccd_stats_json(const CcdStepResult& c) {
+  const CcdCounters& k = c.counters;
+  Json r;
+  r["elementary_tests"] = k.elementary_tests();
+  r["vf_tests"] = k.vf_tests;
+  r["ee_tests"] = k.ee_tests;
+  r["object_pairs"] = k.object_pairs;
+  r["triangle_pairs"] = k.triangle_pairs;
+  r["culled_triangles"] = k.culled_triangles;
+  r["limit_hits"] = k.limit_hits;
+  r["vf_pairs"] = c.vf.size();
+  r["ee_pairs"] = c.ee.size();
+  r["time_ms"] = {{"aabb", c.aabb_ms}, {"voronoi", c.voronoi_ms}, {"exact", c.exact_ms}};
+  return r;
+}
+
 // True when format_json spreads `value` over several lines.
 bool spreads(const Json& value) {
   if (value.is_array()) {
@@ -164,6 +194,7 @@ Json frame_json(const FrameResult& frame, double write_ms) {
     for (const IntraObjectDistance& d : *frame.intra) intra.push_back(intra_json(d));
     j["distance"]["intra"] = std::move(intra);
   }
+  if (frame.ccd) j["ccd"] = ccd_json(*frame.ccd);
   const StageTimes& t = frame.time_ms;
   Json time_ms;
   time_ms["load"] = t.load;
@@ -200,6 +231,7 @@ Json frame_json(const FrameResult& frame, double write_ms) {
     stats["voronoi"] = std::move(vj);
   }
   if (frame.self_voronoi) stats["self_voronoi"] = voronoi_stats_json(*frame.self_voronoi);
+  if (frame.ccd) stats["ccd"] = ccd_stats_json(*frame.ccd);
   j["stats"] = std::move(stats);
   return j;
 }

@@ -1,0 +1,246 @@
+#include "core/geometry/ccd.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace vproxq {
+namespace {
+
+// ---- Rounding bound ------------------------------------------------------------------------
+//
+// Let u = 2^-53 (unit roundoff), M the largest |coordinate k| of the 8 input points, and t, u,
+// v box corners (exact dyadic numbers in [0, 1], see kMinWidth). Every rounded operation
+// x op y returns (x op y)(1 + e), |e| <= u (no FMA: core/ is built with -ffp-contract=off),
+// plus an absolute error below 2^-1075 when the result is subnormal. Per coordinate:
+//
+//  position at time t:  x(t) = x0 + t * fl(x1 - x0)
+//    fl(x1 - x0) = d(1+e1), |d| <= 2M; the product rounds again: |fl(t fl(d)) - t d| <=
+//    2M(2u + u^2); the exact x(t) is a convex combination (|x(t)| <= M), so the final sum
+//    rounds by at most u(M + 4.1Mu). Total: |x̂(t) - x(t)| <= 5Mu (+ O(u^2) terms), and
+//    |x̂(t)| <= M(1 + 6u).
+//  vertex–face:  F = ((p - a) - u (b - a)) - v (c - a), all points at time t
+//    p - a, b - a, c - a: 5+5 propagated + 2M u rounding        -> 12 Mu each, magnitude 2M
+//    u (b - a), v (c - a): 12 propagated + 2M u rounding         -> 14 Mu each
+//    (p - a) - u (b - a): 12 + 14 + 4M u rounding                -> 30 Mu, magnitude 4M
+//    ... - v (c - a):     30 + 14 + 6M u rounding                -> 50 Mu
+//  edge–edge:  F = (a0 + u (a1 - a0)) - (b0 + v (b1 - b0))
+//    a1 - a0: 12 Mu; u (a1 - a0): 14 Mu; a0 + ...: 5 + 14 + M u (a convex combination,
+//    magnitude M) -> 20 Mu; the same for b; the difference: 40 + 2M u -> 42 Mu.
+//
+// So |F̂ - F| <= 50 Mu (1 + O(u)) for both kinds; we use ε = 64 Mu = 2^-47 M, plus 2^-1060 for
+// the at most ~20 subnormal roundings. This holds for every corner of every box, so the exact
+// F over a box lies within [min corner F̂ - ε, max corner F̂ + ε] per coordinate (F is affine
+// in each parameter separately: its extremes over a box are at corners).
+constexpr double kEpsilonFactor = 0x1p-47;
+constexpr double kUnderflowSlack = 0x1p-1060;
+// A box side is never split below 2^-50: corners stay multiples of 2^-50 in [0, 1], so they,
+// their midpoints and u0 + v0 are exact doubles. A box that cannot be excluded, is not yet
+// within δ and cannot be split further is reported as a collision (conservative).
+constexpr double kMinWidth = 0x1p-50;
+// δ_k is at least this multiple of ε_k, so a small enough box always becomes terminal: a
+// corner range that contains 0 within ±ε and has exact width w has rounded width <= w + 2ε,
+// so it lies within ±(4ε + w) — inside ±δ once w <= δ - 4ε.
+constexpr double kDeltaOverEpsilon = 8;
+constexpr double kMaxMagnitude = 0x1p1000;
+
+enum class Kind { VertexFace, EdgeEdge };
+
+struct Box {
+  double t0, t1, u0, u1, v0, v1;
+};
+
+struct Query {
+  Kind kind;
+  double x0[4][3];  ///< start positions
+  double d[4][3];   ///< fl(end - start)
+  double eps[3];
+  double delta[3];
+};
+
+/// The 4 points at time t, rounded exactly as the derivation above assumes.
+inline void positions_at(const Query& q, double t, double out[4][3]) {
+  for (int i = 0; i < 4; ++i)
+    for (int k = 0; k < 3; ++k) out[i][k] = q.x0[i][k] + t * q.d[i][k];
+}
+
+/// F at the 4 (u, v) corners of a box, for the points `x` at one time; corner index bit 1 is
+/// u high, bit 2 v high (bit 0, time high, is added by the caller).
+inline void corner_values(Kind kind, const double x[4][3], const Box& b, double F[8][3], int tbit) {
+  for (int k = 0; k < 3; ++k) {
+    if (kind == Kind::VertexFace) {
+      const double pa = x[0][k] - x[1][k];
+      const double ba = x[2][k] - x[1][k];
+      const double ca = x[3][k] - x[1][k];
+      for (int c = 0; c < 4; ++c) {
+        const double u = (c & 1) ? b.u1 : b.u0;
+        const double v = (c & 2) ? b.v1 : b.v0;
+        F[tbit | (c << 1)][k] = (pa - u * ba) - v * ca;
+      }
+    } else {
+      const double ea = x[1][k] - x[0][k];
+      const double eb = x[3][k] - x[2][k];
+      for (int c = 0; c < 4; ++c) {
+        const double u = (c & 1) ? b.u1 : b.u0;
+        const double v = (c & 2) ? b.v1 : b.v0;
+        F[tbit | (c << 1)][k] = (x[0][k] + u * ea) - (x[2][k] + v * eb);
+      }
+    }
+  }
+}
+
+CcdResult conservative_hit(double t, std::uint32_t boxes) {
+  CcdResult r;
+  r.collides = true;
+  r.toi = t;
+  r.hit_limit = true;
+  r.boxes = boxes;
+  return r;
+}
+
+CcdResult solve(Kind kind, const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end) {
+  Query q;
+  q.kind = kind;
+  double extent = 0;
+  for (int k = 0; k < 3; ++k) {
+    double m = 0, lo = kInfinity, hi = -kInfinity;
+    for (int i = 0; i < 4; ++i) {
+      const double a = start[static_cast<size_t>(i)][k], b = end[static_cast<size_t>(i)][k];
+      if (!std::isfinite(a) || !std::isfinite(b)) return conservative_hit(0, 0);
+      m = std::max({m, std::abs(a), std::abs(b)});
+      lo = std::min({lo, a, b});
+      hi = std::max({hi, a, b});
+      q.x0[i][k] = a;
+      q.d[i][k] = b - a;
+    }
+    if (m > kMaxMagnitude) return conservative_hit(0, 0);
+    q.eps[k] = m * kEpsilonFactor + kUnderflowSlack;
+    extent = std::max(extent, hi - lo);
+  }
+  for (int k = 0; k < 3; ++k)
+    q.delta[k] = std::max(kCcdRelativeTolerance * extent, kDeltaOverEpsilon * q.eps[k]);
+
+  // Depth-first search with pruning. `best` is the smallest t0 of the boxes found within δ
+  // so far; a box with t0 >= best cannot improve the answer and is dropped. Invariant: every
+  // root (t*, u*, v*) lies in a box on the stack, or in a dropped box (then best <= t0 <= t*),
+  // or in a box found within δ (best <= t*). So at the end best <= t* for every root, and
+  // when the search stops at the box limit, min(best, t0 of every box left) is as well.
+  // A box whose t range reaches past `best` is split in t first: its part beyond best is
+  // dropped at once, which keeps degenerate cases (a curve or surface of roots, e.g. parallel
+  // edges) from being refined all along the curve.
+  thread_local std::vector<Box> stack;  // one per thread, reused: queries are many and small
+  stack.clear();
+  stack.push_back({0, 1, 0, 1, 0, 1});
+  CcdResult result;
+  double best = kInfinity;
+  double x[4][3];
+  double F[8][3];
+  while (!stack.empty()) {
+    const Box b = stack.back();
+    stack.pop_back();
+    if (b.t0 >= best) continue;
+    if (result.boxes == kCcdMaxBoxes) {
+      double t = std::min(best, b.t0);
+      for (const Box& r : stack) t = std::min(t, r.t0);
+      return conservative_hit(t, result.boxes);
+    }
+    ++result.boxes;
+    if (kind == Kind::VertexFace && b.u0 + b.v0 > 1) continue;  // outside the triangle
+
+    positions_at(q, b.t0, x);
+    corner_values(kind, x, b, F, 0);
+    positions_at(q, b.t1, x);
+    corner_values(kind, x, b, F, 1);
+
+    bool inside = true;
+    bool excluded = false;
+    for (int k = 0; k < 3 && !excluded; ++k) {
+      double lo = F[0][k], hi = F[0][k];
+      for (int c = 1; c < 8; ++c) {
+        lo = std::min(lo, F[c][k]);
+        hi = std::max(hi, F[c][k]);
+      }
+      if (lo > q.eps[k] || hi < -q.eps[k]) excluded = true;
+      if (hi + q.eps[k] > q.delta[k] || lo - q.eps[k] < -q.delta[k]) inside = false;
+    }
+    if (excluded) continue;
+    if (inside) {
+      best = b.t0;  // b.t0 < best, checked above
+      continue;
+    }
+
+    // Which side to split: t when the box reaches past `best`; otherwise the side along which
+    // F varies most relative to δ (it shrinks the corner range fastest). Corner c and
+    // c | bit differ only in parameter `dim` (bit = 1 << dim).
+    const double width[3] = {b.t1 - b.t0, b.u1 - b.u0, b.v1 - b.v0};
+    int split = -1;
+    if (b.t1 > best && width[0] > kMinWidth) {
+      split = 0;
+    } else {
+      double best_var = -1;
+      for (int dim = 0; dim < 3; ++dim) {
+        if (width[dim] <= kMinWidth) continue;
+        const int bit = 1 << dim;
+        double var = 0;
+        for (int c = 0; c < 8; ++c) {
+          if (c & bit) continue;
+          for (int k = 0; k < 3; ++k)
+            var = std::max(var, std::abs(F[c | bit][k] - F[c][k]) / q.delta[k]);
+        }
+        var *= 1 + width[dim];  // ties (no variation) go to the wider side
+        if (var > best_var) {
+          best_var = var;
+          split = dim;
+        }
+      }
+    }
+    if (split < 0) {
+      // Cannot be split further nor excluded: count it as a hit at its t0 (conservative).
+      result.hit_limit = true;
+      best = b.t0;
+      continue;
+    }
+    Box lo = b, hi = b;
+    if (split == 0) {
+      const double m = 0.5 * (b.t0 + b.t1);
+      lo.t1 = m;
+      hi.t0 = m;
+    } else if (split == 1) {
+      const double m = 0.5 * (b.u0 + b.u1);
+      lo.u1 = m;
+      hi.u0 = m;
+    } else {
+      const double m = 0.5 * (b.v0 + b.v1);
+      lo.v1 = m;
+      hi.v0 = m;
+    }
+    // Later in t (or any order for u, v) first onto the stack: the earlier half is searched
+    // first, so `best` drops early and prunes more.
+    stack.push_back(hi);
+    stack.push_back(lo);
+  }
+  if (best < kInfinity) {
+    result.collides = true;
+    result.toi = best;
+  }
+  return result;
+}
+
+}  // namespace
+
+CcdResult vertex_face_ccd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end) {
+  return solve(Kind::VertexFace, start, end);
+}
+
+CcdResult edge_edge_ccd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end) {
+  return solve(Kind::EdgeEdge, start, end);
+}
+
+double ccd_max_tolerance(double extent, double magnitude) {
+  const double eps = magnitude * kEpsilonFactor + kUnderflowSlack;
+  // The widening by 2^-40 absorbs the rounding of these few operations (they are monotone,
+  // so a query inside the given bounds never gets a larger value).
+  return std::max(kCcdRelativeTolerance * extent, kDeltaOverEpsilon * eps) * (1 + 0x1p-40);
+}
+
+}  // namespace vproxq

@@ -1,0 +1,397 @@
+#include "core/query/ccd.hpp"
+
+#include "core/broad_phase/object_broad_phase.hpp"
+#include "core/broad_phase/triangle_bvh.hpp"
+#include "core/geometry/ccd.hpp"
+#include "core/mesh/adjacency.hpp"
+#include "core/parallel.hpp"
+#include "core/timer.hpp"
+#include "core/voronoi/ccd_stage2.hpp"
+
+#include <algorithm>
+#include <map>
+#include <tuple>
+
+namespace vproxq {
+namespace {
+
+// Deduplication by ownership: a vertex is owned by its smallest incident triangle, an edge by
+// its smallest incident triangle. A candidate triangle pair (f, g) tests vertex v of f against
+// face g only if f owns v, and edge e of f against edge e' of g only if f owns e and g owns e'.
+// So each primitive pair is tested from exactly one triangle pair. No pair that can be
+// reported is lost: if the kernel can report (v, g), v's swept path comes within the margin
+// of g's swept prism, and v's path lies in the swept prism (and box) of every triangle using
+// v — in particular its owner's — so the culling keeps (owner(v), g); likewise for edges.
+struct Ownership {
+  std::vector<Index> vertex;  ///< owner triangle per vertex (kNoIndex: used by no face)
+  std::vector<Index> edge;    ///< owner triangle per edge id
+};
+
+Ownership ownership(const Topology& topo) {
+  const Adjacency& adj = adjacency(topo);
+  Ownership o;
+  o.vertex.assign(static_cast<size_t>(topo.num_vertices), kNoIndex);
+  for (Index v = 0; v < topo.num_vertices; ++v) {
+    const IndexSpan tris = adj.vertex_triangles(v);
+    if (!tris.empty()) o.vertex[static_cast<size_t>(v)] = tris[0];
+  }
+  o.edge.resize(adj.edges().size());
+  for (size_t e = 0; e < adj.edges().size(); ++e) o.edge[e] = adj.edge_triangles(static_cast<Index>(e))[0];
+  return o;
+}
+
+bool in_face(Index v, const Face& f) { return f[0] == v || f[1] == v || f[2] == v; }
+
+bool share_endpoint(const std::array<Index, 2>& a, const std::array<Index, 2>& b) {
+  return a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1];
+}
+
+bool boxes_overlap(const AABB& a, const AABB& b) {
+  for (int k = 0; k < 3; ++k)
+    if (a.lo[k] > b.hi[k] || b.lo[k] > a.hi[k]) return false;
+  return true;
+}
+
+/// Results and counters of one unit of work.
+struct Hits {
+  std::vector<CcdVertexFace> vf;
+  std::vector<CcdEdgeEdge> ee;
+  CcdCounters counters;
+};
+
+/// The elementary tests, with the argument order shared by the pipeline and the brute force
+/// (so both compute bit-identical TOIs).
+class Tester {
+ public:
+  Tester(const Frame& from, const Frame& to) : from_(from), to_(to) {}
+
+  void vertex_face(Index ov, Index v, Index of, Index f, Hits& out) const {
+    const Object& a0 = from_.objects[static_cast<size_t>(ov)];
+    const Object& a1 = to_.objects[static_cast<size_t>(ov)];
+    const Object& b0 = from_.objects[static_cast<size_t>(of)];
+    const Object& b1 = to_.objects[static_cast<size_t>(of)];
+    const Face& face = b0.topology->faces[static_cast<size_t>(f)];
+    const std::array<Vec3, 4> s{a0.positions[static_cast<size_t>(v)], b0.positions[static_cast<size_t>(face[0])],
+                                b0.positions[static_cast<size_t>(face[1])], b0.positions[static_cast<size_t>(face[2])]};
+    const std::array<Vec3, 4> e{a1.positions[static_cast<size_t>(v)], b1.positions[static_cast<size_t>(face[0])],
+                                b1.positions[static_cast<size_t>(face[1])], b1.positions[static_cast<size_t>(face[2])]};
+    ++out.counters.vf_tests;
+    const CcdResult r = vertex_face_ccd(s, e);
+    out.counters.limit_hits += r.hit_limit;
+    if (r.collides) out.vf.push_back({ov, v, of, f, r.toi});
+  }
+
+  /// (oa, ea) must be the smaller of the two (object, edge id).
+  void edge_edge(Index oa, const std::array<Index, 2>& ea, Index ob, const std::array<Index, 2>& eb,
+                 Hits& out) const {
+    const Object& a0 = from_.objects[static_cast<size_t>(oa)];
+    const Object& a1 = to_.objects[static_cast<size_t>(oa)];
+    const Object& b0 = from_.objects[static_cast<size_t>(ob)];
+    const Object& b1 = to_.objects[static_cast<size_t>(ob)];
+    const std::array<Vec3, 4> s{a0.positions[static_cast<size_t>(ea[0])], a0.positions[static_cast<size_t>(ea[1])],
+                                b0.positions[static_cast<size_t>(eb[0])], b0.positions[static_cast<size_t>(eb[1])]};
+    const std::array<Vec3, 4> e{a1.positions[static_cast<size_t>(ea[0])], a1.positions[static_cast<size_t>(ea[1])],
+                                b1.positions[static_cast<size_t>(eb[0])], b1.positions[static_cast<size_t>(eb[1])]};
+    ++out.counters.ee_tests;
+    const CcdResult r = edge_edge_ccd(s, e);
+    out.counters.limit_hits += r.hit_limit;
+    if (r.collides) out.ee.push_back({oa, ea, ob, eb, r.toi});
+  }
+
+ private:
+  const Frame& from_;
+  const Frame& to_;
+};
+
+AABB swept_box(const Object& a, const Object& b, std::initializer_list<Index> vertices) {
+  AABB box;
+  for (Index v : vertices) {
+    box.extend(a.positions[static_cast<size_t>(v)]);
+    box.extend(b.positions[static_cast<size_t>(v)]);
+  }
+  return box;
+}
+
+void add(CcdCounters& a, const CcdCounters& b) {
+  a.object_pairs += b.object_pairs;
+  a.triangle_pairs += b.triangle_pairs;
+  a.vf_tests += b.vf_tests;
+  a.ee_tests += b.ee_tests;
+  a.limit_hits += b.limit_hits;
+  a.culled_triangles += b.culled_triangles;
+}
+
+/// Sorts the hits canonically and summarises them per object pair.
+void finish(std::vector<Hits>& parts, CcdStepResult& out) {
+  for (Hits& h : parts) {
+    out.vf.insert(out.vf.end(), h.vf.begin(), h.vf.end());
+    out.ee.insert(out.ee.end(), h.ee.begin(), h.ee.end());
+    add(out.counters, h.counters);
+  }
+  std::sort(out.vf.begin(), out.vf.end(), [](const CcdVertexFace& a, const CcdVertexFace& b) {
+    return std::tie(a.object_v, a.vertex, a.object_f, a.face) <
+           std::tie(b.object_v, b.vertex, b.object_f, b.face);
+  });
+  std::sort(out.ee.begin(), out.ee.end(), [](const CcdEdgeEdge& a, const CcdEdgeEdge& b) {
+    return std::tie(a.object_a, a.edge_a, a.object_b, a.edge_b) <
+           std::tie(b.object_a, b.edge_a, b.object_b, b.edge_b);
+  });
+  std::map<std::pair<Index, Index>, CcdObjectPair> pairs;
+  auto note = [&](Index a, Index b, double toi) {
+    const auto key = std::minmax(a, b);
+    CcdObjectPair& p = pairs[{key.first, key.second}];
+    if (p.primitive_pairs == 0 || toi < p.toi) p.toi = toi;
+    p.objects = {key.first, key.second};
+    ++p.primitive_pairs;
+  };
+  for (const auto& h : out.vf) note(h.object_v, h.object_f, h.toi);
+  for (const auto& h : out.ee) note(h.object_a, h.object_b, h.toi);
+  for (const auto& kv : pairs) out.pairs.push_back(kv.second);
+}
+
+constexpr Index kChunk = 256;  ///< triangles per unit of parallel work
+
+}  // namespace
+
+CcdParticipants ccd_participants(const Frame& from, const Frame& to) {
+  CcdParticipants p;
+  for (size_t i = 0; i < from.objects.size(); ++i) {
+    const Object& a = from.objects[i];
+    const Index id = static_cast<Index>(i);
+    if (i >= to.objects.size()) {
+      p.skipped.push_back({id, "no counterpart in frame " + std::to_string(to.index) + " (it has " +
+                                   std::to_string(to.objects.size()) + " objects)"});
+      continue;
+    }
+    const Object& b = to.objects[i];
+    if (a.topology != b.topology && *a.topology != *b.topology) {
+      std::string reason = "topology changes between frames " + std::to_string(from.index) +
+                           " and " + std::to_string(to.index);
+      if (a.num_vertices() != b.num_vertices() || a.num_triangles() != b.num_triangles())
+        reason += " (" + std::to_string(a.num_vertices()) + " vertices, " +
+                  std::to_string(a.num_triangles()) + " faces -> " + std::to_string(b.num_vertices()) +
+                  " vertices, " + std::to_string(b.num_triangles()) + " faces)";
+      else
+        reason += " (same counts, different faces)";
+      p.skipped.push_back({id, reason});
+      continue;
+    }
+    p.objects.push_back(id);
+  }
+  return p;
+}
+
+CcdSweep CcdSweep::compute(const Frame& from, const Frame& to, int threads) {
+  CcdSweep s;
+  s.participants = ccd_participants(from, to);
+  const size_t n = from.objects.size();
+  s.triangles.assign(n, {});
+  s.objects.assign(n, AABB{});
+  // Margin from the coordinates of the step (both frames, participating objects).
+  AABB all;
+  double magnitude = 0;
+  for (Index i : s.participants.objects) {
+    for (const Frame* f : {&from, &to})
+      for (const Vec3& p : f->objects[static_cast<size_t>(i)].positions) {
+        all.extend(p);
+        magnitude = std::max(magnitude, p.cwiseAbs().maxCoeff());
+      }
+  }
+  const double extent = all.empty() ? 0.0 : (all.hi - all.lo).maxCoeff();
+  s.margin = ccd_max_tolerance(extent, magnitude) + rounding_slack(magnitude);
+  const auto& ids = s.participants.objects;
+  parallel_for(ids.size(), threads, [&](size_t k) {
+    const size_t i = static_cast<size_t>(ids[k]);
+    const Object& a = from.objects[i];
+    const Object& b = to.objects[i];
+    auto& tb = s.triangles[i];
+    tb.resize(static_cast<size_t>(a.num_triangles()));
+    AABB box;
+    for (Index t = 0; t < a.num_triangles(); ++t) {
+      const Face& f = a.topology->faces[static_cast<size_t>(t)];
+      AABB tri = swept_box(a, b, {f[0], f[1], f[2]});
+      tri.lo.array() -= s.margin;
+      tri.hi.array() += s.margin;
+      tb[static_cast<size_t>(t)] = tri;
+      box.extend(tri);
+    }
+    s.objects[i] = box;
+  });
+  return s;
+}
+
+CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const CcdOptions& opts) {
+  Stopwatch sw;
+  const CcdSweep sweep = CcdSweep::compute(from, to, std::max(1, opts.threads));
+  const double ms = sw.elapsed_ms();
+  CcdStepResult r = continuous_collisions(from, to, sweep, opts);
+  r.aabb_ms += ms;
+  return r;
+}
+
+CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const CcdSweep& sweep,
+                                    const CcdOptions& opts) {
+  const int threads = std::max(1, opts.threads);
+  CcdStepResult out;
+  out.to_frame = to.index;
+  out.skipped = sweep.participants.skipped;
+  Stopwatch sw;
+
+  // Stage I, object level: sweep and prune along x over the swept object boxes.
+  std::vector<Index> live;
+  for (Index i : sweep.participants.objects)
+    if (from.objects[static_cast<size_t>(i)].num_triangles() > 0) live.push_back(i);
+  std::vector<Index> by_x = live;
+  std::sort(by_x.begin(), by_x.end(), [&](Index a, Index b) {
+    const double la = sweep.objects[static_cast<size_t>(a)].lo.x(), lb = sweep.objects[static_cast<size_t>(b)].lo.x();
+    return la < lb || (la == lb && a < b);
+  });
+  std::vector<std::pair<Index, Index>> object_pairs;
+  for (Index i : live) object_pairs.emplace_back(i, i);
+  for (size_t a = 0; a < by_x.size(); ++a) {
+    const AABB& ba = sweep.objects[static_cast<size_t>(by_x[a])];
+    for (size_t b = a + 1; b < by_x.size(); ++b) {
+      const AABB& bb = sweep.objects[static_cast<size_t>(by_x[b])];
+      if (bb.lo.x() > ba.hi.x()) break;
+      if (boxes_overlap(ba, bb)) object_pairs.emplace_back(std::min(by_x[a], by_x[b]), std::max(by_x[a], by_x[b]));
+    }
+  }
+  std::sort(object_pairs.begin(), object_pairs.end());
+  out.counters.object_pairs = object_pairs.size();
+
+  std::vector<TriangleBvh> bvhs(from.objects.size());
+  std::vector<Ownership> owners(from.objects.size());
+  parallel_for(live.size(), threads, [&](size_t k) {
+    const size_t i = static_cast<size_t>(live[k]);
+    bvhs[i].build(sweep.triangles[i]);
+    owners[i] = ownership(*from.objects[i].topology);
+  });
+  out.aabb_ms = sw.elapsed_ms();
+  sw.restart();
+
+  // Units of work: (object pair, chunk of the first object's triangles).
+  struct Task {
+    Index i, j, first, last;
+  };
+  std::vector<Task> tasks;
+  for (const auto& [i, j] : object_pairs) {
+    const Index n = from.objects[static_cast<size_t>(i)].num_triangles();
+    for (Index t = 0; t < n; t += kChunk) tasks.push_back({i, j, t, std::min(n, t + kChunk)});
+  }
+  const Tester tester(from, to);
+  const CcdVoxelCulling* voxels = opts.voxels;
+  std::vector<Hits> parts(tasks.size());
+  parallel_for(tasks.size(), threads, [&](size_t k) {
+    const Task& task = tasks[k];
+    const Index i = task.i, j = task.j;
+    const Object& oi = from.objects[static_cast<size_t>(i)];
+    const Object& oi1 = to.objects[static_cast<size_t>(i)];
+    const Object& oj = from.objects[static_cast<size_t>(j)];
+    const Object& oj1 = to.objects[static_cast<size_t>(j)];
+    const Adjacency& adj_i = adjacency(*oi.topology);
+    const Adjacency& adj_j = adjacency(*oj.topology);
+    const Ownership& own_i = owners[static_cast<size_t>(i)];
+    const Ownership& own_j = owners[static_cast<size_t>(j)];
+    const auto& tb_i = sweep.triangles[static_cast<size_t>(i)];
+    const auto& tb_j = sweep.triangles[static_cast<size_t>(j)];
+    const AABB& box_j = sweep.objects[static_cast<size_t>(j)];
+    const bool self = i == j;
+    Hits& hits = parts[k];
+
+    // Vertex v of object ov (owned by tri fv) against face g of object og.
+    auto vertex_face = [&](Index ov, const Object& a0, const Object& a1, Index v, Index og,
+                           const Face& g_face, Index g, const AABB& g_box) {
+      if (self && in_face(v, g_face)) return;
+      // The vertex's own swept box against the face's widened one: exact comparisons.
+      if (!boxes_overlap(swept_box(a0, a1, {v}), g_box)) return;
+      tester.vertex_face(ov, v, og, g, hits);
+    };
+
+    for (Index f = task.first; f < task.last; ++f) {
+      const AABB& fb = tb_i[static_cast<size_t>(f)];
+      if (!self && !boxes_overlap(fb, box_j)) continue;
+      if (voxels && !self && !voxels->keeps(i, f)) {
+        ++hits.counters.culled_triangles;
+        continue;
+      }
+      const Face& ff = oi.topology->faces[static_cast<size_t>(f)];
+      bvhs[static_cast<size_t>(j)].query(fb, [] { return 0.0; }, [&](Index g, double) {
+        if (self && g <= f) return;  // each unordered pair once
+        if (voxels && (!self && !voxels->keeps(j, g))) return;
+        if (voxels && !voxels->share_voxel(i, f, j, g)) return;
+        ++hits.counters.triangle_pairs;
+        const Face& gf = oj.topology->faces[static_cast<size_t>(g)];
+        const AABB& gb = tb_j[static_cast<size_t>(g)];
+        for (Index v : ff)
+          if (own_i.vertex[static_cast<size_t>(v)] == f) vertex_face(i, oi, oi1, v, j, gf, g, gb);
+        for (Index w : gf)
+          if (own_j.vertex[static_cast<size_t>(w)] == g) vertex_face(j, oj, oj1, w, i, ff, f, fb);
+        const auto& fe = adj_i.triangle_edges(f);
+        const auto& ge = adj_j.triangle_edges(g);
+        for (Index ea : fe) {
+          if (ea == kNoIndex || own_i.edge[static_cast<size_t>(ea)] != f) continue;
+          const auto& va = adj_i.edges()[static_cast<size_t>(ea)];
+          const AABB ba = swept_box(oi, oi1, {va[0], va[1]});
+          for (Index eb : ge) {
+            if (eb == kNoIndex || own_j.edge[static_cast<size_t>(eb)] != g) continue;
+            const auto& vb = adj_j.edges()[static_cast<size_t>(eb)];
+            if (self && share_endpoint(va, vb)) continue;
+            AABB bb = swept_box(oj, oj1, {vb[0], vb[1]});
+            bb.lo.array() -= sweep.margin;
+            bb.hi.array() += sweep.margin;
+            if (!boxes_overlap(ba, bb)) continue;
+            // Canonical order: the smaller (object, edge id) first.
+            if (i < j || (self && ea < eb))
+              tester.edge_edge(i, va, j, vb, hits);
+            else
+              tester.edge_edge(j, vb, i, va, hits);
+          }
+        }
+      });
+    }
+  });
+  finish(parts, out);
+  out.exact_ms = sw.elapsed_ms();
+  return out;
+}
+
+CcdStepResult continuous_collisions_brute_force(const Frame& from, const Frame& to) {
+  CcdStepResult out;
+  out.to_frame = to.index;
+  const CcdParticipants p = ccd_participants(from, to);
+  out.skipped = p.skipped;
+  const Tester tester(from, to);
+  std::vector<Hits> parts(1);
+  Hits& hits = parts[0];
+  for (size_t a = 0; a < p.objects.size(); ++a) {
+    for (size_t b = a; b < p.objects.size(); ++b) {
+      const Index i = p.objects[a], j = p.objects[b];
+      const Topology& ti = *from.objects[static_cast<size_t>(i)].topology;
+      const Topology& tj = *from.objects[static_cast<size_t>(j)].topology;
+      const Ownership oi = ownership(ti), oj = ownership(tj);
+      const Adjacency& ai = adjacency(ti);
+      const Adjacency& aj = adjacency(tj);
+      // Vertices of i against faces of j and, for two objects, vertices of j against faces of i.
+      auto vf = [&](Index ov, const Ownership& own, Index of, const Topology& tf) {
+        for (Index v = 0; v < static_cast<Index>(own.vertex.size()); ++v) {
+          if (own.vertex[static_cast<size_t>(v)] == kNoIndex) continue;
+          for (Index g = 0; g < tf.num_triangles(); ++g) {
+            if (ov == of && in_face(v, tf.faces[static_cast<size_t>(g)])) continue;
+            tester.vertex_face(ov, v, of, g, hits);
+          }
+        }
+      };
+      vf(i, oi, j, tj);
+      if (i != j) vf(j, oj, i, ti);
+      for (size_t ea = 0; ea < ai.edges().size(); ++ea)
+        for (size_t eb = (i == j ? ea + 1 : 0); eb < aj.edges().size(); ++eb) {
+          if (i == j && share_endpoint(ai.edges()[ea], aj.edges()[eb])) continue;
+          tester.edge_edge(i, ai.edges()[ea], j, aj.edges()[eb], hits);
+        }
+    }
+  }
+  finish(parts, out);
+  return out;
+}
+
+}  // namespace vproxq

@@ -1,0 +1,67 @@
+#pragma once
+// Continuous collision detection between two frames (paper 3.2, 5.3): every vertex–face and
+// edge–edge pair that collides while the vertices move linearly from frame k to frame k+1,
+// inter-object and intra-object, with its earliest time of impact.
+//
+// Pipeline: objects are matched by position in the frames' lists; an object whose counterpart
+// is missing or whose topology differs is skipped for the step (CcdStepResult::skipped).
+// Stage I: swept boxes (the box of a triangle's 6 positions, widened by the culling margin
+// below), sweep-and-prune over the swept object boxes, then per object pair a BVH over the
+// swept triangle boxes gives the candidate triangle pairs. Optional Stage II
+// (core/voronoi/ccd_stage2.hpp) culls them further with a voxelization of the swept prisms.
+// Stage III: the elementary tests of core/geometry/ccd.hpp, each vertex–face and edge–edge pair
+// tested once (see ccd.cpp for the ownership rule that deduplicates without a global set).
+//
+// Exclusions: a vertex–face pair whose vertex is a corner of the face, and an edge–edge pair
+// of one object sharing a vertex. Vertices used by no face take no part.
+//
+// Culling margin: the kernel may report a pair whose primitives come within its tolerance δ
+// (never more than ccd_max_tolerance() for this step's coordinates); all boxes are widened by
+// that plus rounding_slack(), so culling never removes a pair the kernel would report and the
+// results equal the brute force — with one documented exception: a test that stops at the
+// kernel's box limit (counters.limit_hits) is reported without a proximity guarantee, so brute
+// force could report such a pair where culling (correctly: it cannot collide) removed it.
+#include "core/broad_phase/aabb.hpp"
+#include "core/results.hpp"
+#include "core/scene.hpp"
+
+namespace vproxq {
+
+class CcdVoxelCulling;
+
+struct CcdOptions {
+  int threads = 1;
+  /// Stage II: culling by a conservative voxelization of the swept triangles, or null.
+  /// Built by the caller for this step (ccd_stage2.hpp); it never changes the answer.
+  const CcdVoxelCulling* voxels = nullptr;
+};
+
+/// The objects of `from` that take part in the step, with the reason for each one left out.
+struct CcdParticipants {
+  std::vector<Index> objects;  ///< ids in `from`, ascending
+  std::vector<CcdSkipped> skipped;
+};
+CcdParticipants ccd_participants(const Frame& from, const Frame& to);
+
+/// Swept geometry of a step shared by Stage I, II and III.
+struct CcdSweep {
+  CcdParticipants participants;
+  /// Culling margin (see above) added on every side of every swept box.
+  double margin = 0;
+  /// [object][triangle] swept boxes (widened), empty for skipped objects.
+  std::vector<std::vector<AABB>> triangles;
+  std::vector<AABB> objects;  ///< union of an object's swept triangle boxes
+  static CcdSweep compute(const Frame& from, const Frame& to, int threads);
+};
+
+/// The whole pipeline: Stage I, Stage II when opts.voxels is set, Stage III.
+/// Deterministic: the result does not depend on the thread count.
+CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const CcdSweep& sweep,
+                                    const CcdOptions& opts);
+CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const CcdOptions& opts);
+
+/// Every vertex–face and edge–edge pair of the participating objects, no culling: the
+/// reference for tests. The same exclusions, argument order and output order.
+CcdStepResult continuous_collisions_brute_force(const Frame& from, const Frame& to);
+
+}  // namespace vproxq

@@ -1,0 +1,178 @@
+// End-to-end CCD through the CLI: `--queries=ccd` on small seeded multi-frame scenes gives the
+// brute force's answers (all primitive pairs, elementary tests) in results.json and
+// results.h5, identical with --voronoi=off, cpu and gpu; the last frame has no ccd block;
+// an object whose topology changes is listed in ccd.skipped.
+#include "core/query/ccd.hpp"
+#include "io/hdf5_reader.hpp"
+#include "io/scene_source.hpp"
+#include "support/process.hpp"
+#include "support/random_scene.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+
+namespace vproxq {
+namespace {
+
+namespace fs = std::filesystem;
+using test::quote;
+using test::run_command;
+using test::ScratchDir;
+
+const std::string kVproxq = VPROXQ_BINARY;
+
+test::ProcessResult vproxq(const std::string& args) { return run_command(kVproxq + " " + args); }
+
+nlohmann::json read_json(const fs::path& p) {
+  std::ifstream in(p);
+  return nlohmann::json::parse(in);
+}
+
+/// One OBJ per frame, an `o` group per object, 17 significant digits (exact round trip).
+void write_obj(const Frame& frame, const fs::path& file) {
+  std::ofstream out(file);
+  out.precision(17);
+  Index base = 1;
+  for (const Object& o : frame.objects) {
+    out << "o " << o.name << "\n";
+    for (const Vec3& p : o.positions) out << "v " << p.x() << " " << p.y() << " " << p.z() << "\n";
+    for (const Face& f : o.topology->faces)
+      out << "f " << f[0] + base << " " << f[1] + base << " " << f[2] + base << "\n";
+    base += o.num_vertices();
+  }
+}
+
+/// Frame `prev` with every object drifted and its vertices jittered (same topologies).
+Frame moved(const Frame& prev, test::Rng& rng, double drift, double jitter) {
+  Frame f = prev;
+  for (Object& o : f.objects) {
+    const Vec3 d(rng.uniform(-drift, drift), rng.uniform(-drift, drift), rng.uniform(-drift, drift));
+    for (Vec3& p : o.positions)
+      p += d + Vec3(rng.uniform(-jitter, jitter), rng.uniform(-jitter, jitter), rng.uniform(-jitter, jitter));
+  }
+  return f;
+}
+
+/// A scene of `frames` frames of `n` moving blobs; returns the scene.json path.
+fs::path write_scene(const ScratchDir& dir, std::uint64_t seed, int n, int frames) {
+  test::Rng rng(seed * 7 + 1);
+  Frame f = test::make_random_frame(seed, n, 2.5, 1);
+  for (int k = 0; k < frames; ++k) {
+    write_obj(f, dir / ("f_" + std::to_string(k) + ".obj"));
+    f = moved(f, rng, 0.5, k % 2 ? 0.2 : 0.05);
+  }
+  return dir.write("scene.json", R"({"frames": {"pattern": "f_%d.obj", "first": 0, "count": )" +
+                                     std::to_string(frames) + R"(}, "queries": ["ccd"]})");
+}
+
+/// Every frame's ccd block (JSON) and ccd/vf, ccd/ee (HDF5) equal the brute force.
+void expect_equal_brute_force(const fs::path& scene_path, const fs::path& out, std::uint64_t& found) {
+  const SceneSource scene = SceneSource::open(scene_path);
+  const auto j = read_json(out / "results.json");
+  const Hdf5Reader h5(out / "results.h5");
+  const size_t n = scene.frame_count();
+  ASSERT_EQ(j["frames"].size(), n);
+  for (size_t k = 0; k < n; ++k) {
+    SCOPED_TRACE("frame " + std::to_string(k));
+    const auto& fj = j["frames"][k];
+    char group[64];
+    std::snprintf(group, sizeof group, "/frames/%06zu/ccd", k);
+    if (k + 1 == n) {
+      EXPECT_FALSE(fj.contains("ccd"));  // the last frame has no next frame
+      EXPECT_FALSE(h5.exists(group));
+      continue;
+    }
+    const CcdStepResult ref = continuous_collisions_brute_force(scene.load_frame(k), scene.load_frame(k + 1));
+    found += ref.vf.size() + ref.ee.size();
+    ASSERT_TRUE(fj.contains("ccd"));
+    EXPECT_EQ(fj["ccd"]["to_frame"].get<int>(), static_cast<int>(k + 1));
+    EXPECT_TRUE(fj["ccd"]["skipped"].empty());
+    const auto& pairs = fj["ccd"]["pairs"];
+    ASSERT_EQ(pairs.size(), ref.pairs.size());
+    for (size_t p = 0; p < ref.pairs.size(); ++p) {
+      EXPECT_EQ(pairs[p]["objects"][0].get<int>(), ref.pairs[p].objects[0]);
+      EXPECT_EQ(pairs[p]["objects"][1].get<int>(), ref.pairs[p].objects[1]);
+      EXPECT_EQ(pairs[p]["toi"].get<double>(), ref.pairs[p].toi);
+      EXPECT_EQ(pairs[p]["primitive_pairs"].get<std::uint64_t>(), ref.pairs[p].primitive_pairs);
+    }
+    const std::string g = group;
+    ASSERT_EQ(h5.rows(g + "/vf"), ref.vf.size());
+    const auto ov = h5.int_field(g + "/vf", "object_v"), v = h5.int_field(g + "/vf", "vertex");
+    const auto of = h5.int_field(g + "/vf", "object_f"), f = h5.int_field(g + "/vf", "face");
+    const auto vt = h5.double_field(g + "/vf", "toi");
+    for (size_t r = 0; r < ref.vf.size(); ++r) {
+      EXPECT_EQ(ov[r], ref.vf[r].object_v);
+      EXPECT_EQ(v[r], ref.vf[r].vertex);
+      EXPECT_EQ(of[r], ref.vf[r].object_f);
+      EXPECT_EQ(f[r], ref.vf[r].face);
+      EXPECT_EQ(vt[r], ref.vf[r].toi);
+    }
+    ASSERT_EQ(h5.rows(g + "/ee"), ref.ee.size());
+    const auto oa = h5.int_field(g + "/ee", "object_a"), a0 = h5.int_field(g + "/ee", "a0");
+    const auto a1 = h5.int_field(g + "/ee", "a1"), ob = h5.int_field(g + "/ee", "object_b");
+    const auto b0 = h5.int_field(g + "/ee", "b0"), b1 = h5.int_field(g + "/ee", "b1");
+    const auto et = h5.double_field(g + "/ee", "toi");
+    for (size_t r = 0; r < ref.ee.size(); ++r) {
+      EXPECT_EQ(oa[r], ref.ee[r].object_a);
+      EXPECT_EQ(a0[r], ref.ee[r].edge_a[0]);
+      EXPECT_EQ(a1[r], ref.ee[r].edge_a[1]);
+      EXPECT_EQ(ob[r], ref.ee[r].object_b);
+      EXPECT_EQ(b0[r], ref.ee[r].edge_b[0]);
+      EXPECT_EQ(b1[r], ref.ee[r].edge_b[1]);
+      EXPECT_EQ(et[r], ref.ee[r].toi);
+    }
+    EXPECT_EQ(h5.uint_attribute(g, "elementary_tests"),
+              fj["stats"]["ccd"]["elementary_tests"].get<std::uint64_t>());
+  }
+}
+
+TEST(CcdCli, BackendsGiveIdenticalResultsEqualToBruteForce) {
+  std::uint64_t found = 0;
+  for (std::uint64_t seed : {3u, 8u}) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    ScratchDir dir;
+    const fs::path scene = write_scene(dir, seed, 4, 3);
+    for (const char* backend : {"off", "cpu", "gpu"}) {
+      SCOPED_TRACE(backend);
+      const auto out = dir / backend;
+      const auto r = vproxq(quote(scene) + " -o " + quote(out) + " --quiet --threads 2 --grid 24 --voronoi=" + backend);
+      ASSERT_EQ(r.exit_code, 0) << r.output;
+      expect_equal_brute_force(scene, out, found);
+    }
+    for (const char* backend : {"cpu", "gpu"}) {
+      const auto r = vproxq("diff " + quote(dir / "off" / "results.json") + " " + quote(dir / backend / "results.json"));
+      EXPECT_EQ(r.exit_code, 0) << backend << ": " << r.output;
+    }
+  }
+  EXPECT_GT(found, 0u) << "the scenes must have collisions for the comparison to mean much";
+}
+
+TEST(CcdCli, TopologyChangeIsSkippedWithReason) {
+  ScratchDir dir;
+  Frame f0 = test::make_random_frame(5, 3, 2.0, 1);
+  Frame f1 = f0;
+  auto topo = std::make_shared<Topology>(*f1.objects[1].topology);
+  topo->faces.pop_back();  // a face disappears: the topology changes
+  f1.objects[1].topology = topo;
+  write_obj(f0, dir / "f_0.obj");
+  write_obj(f1, dir / "f_1.obj");
+  const auto scene = dir.write("scene.json", R"({"frames": {"pattern": "f_%d.obj", "first": 0, "count": 2}})");
+  const auto r = vproxq(quote(scene) + " --queries=ccd,distance -o " + quote(dir / "out") + " --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = read_json(dir / "out" / "results.json");
+  const auto& skipped = j["frames"][0]["ccd"]["skipped"];
+  ASSERT_EQ(skipped.size(), 1u);
+  EXPECT_EQ(skipped[0]["object"].get<int>(), 1);
+  EXPECT_NE(skipped[0]["reason"].get<std::string>().find("topology changes"), std::string::npos);
+  EXPECT_TRUE(j["frames"][0].contains("distance"));
+  const Hdf5Reader h5(dir / "out" / "results.h5");
+  EXPECT_EQ(h5.rows("/frames/000000/ccd/skipped_objects"), 1u);
+  const auto reasons = h5.strings_dataset("/frames/000000/ccd/skipped_reasons");
+  ASSERT_EQ(reasons.size(), 1u);
+  EXPECT_EQ(reasons[0], skipped[0]["reason"].get<std::string>());
+}
+
+}  // namespace
+}  // namespace vproxq

@@ -1,0 +1,233 @@
+// Tests of the elementary CCD tests (core/geometry/ccd.hpp) on cases with known answers:
+// contact at t = 0 and t = 1, coplanar sliding, parallel and collinear edges, degenerate
+// triangles and edges, no motion, near misses; plus seeded random queries constructed to
+// collide at a known time (the reported TOI must not exceed it) or to stay apart.
+#include <gtest/gtest.h>
+
+#include "core/geometry/ccd.hpp"
+#include "support/random_scene.hpp"
+
+#include <array>
+
+namespace vproxq {
+namespace {
+
+using P4 = std::array<Vec3, 4>;
+
+// A static unit right triangle in the plane z = 0.
+const Vec3 kA(0, 0, 0), kB(1, 0, 0), kC(0, 1, 0);
+
+CcdResult vf_static_triangle(const Vec3& p0, const Vec3& p1) {
+  return vertex_face_ccd(P4{p0, kA, kB, kC}, P4{p1, kA, kB, kC});
+}
+
+// A tolerance on TOIs: the finder stops at boxes whose image is within δ ~ 1e-6 * extent.
+constexpr double kToiSlack = 1e-5;
+
+TEST(CcdKernel, VertexThroughTriangle) {
+  const CcdResult r = vf_static_triangle({0.2, 0.2, 1}, {0.2, 0.2, -1});
+  ASSERT_TRUE(r.collides);
+  EXPECT_LE(r.toi, 0.5);
+  EXPECT_GE(r.toi, 0.5 - kToiSlack);
+  EXPECT_FALSE(r.hit_limit);
+}
+
+TEST(CcdKernel, VertexPassesBeside) {
+  EXPECT_FALSE(vf_static_triangle({2, 2, 1}, {2, 2, -1}).collides);
+  // Just outside the hypotenuse x + y = 1 (by 1e-3, far above δ).
+  EXPECT_FALSE(vf_static_triangle({0.5005, 0.5005, 1}, {0.5005, 0.5005, -1}).collides);
+  // Stops just before the plane.
+  EXPECT_FALSE(vf_static_triangle({0.2, 0.2, 1}, {0.2, 0.2, 1e-3}).collides);
+}
+
+TEST(CcdKernel, VertexContactAtStart) {
+  const CcdResult r = vf_static_triangle({0.2, 0.2, 0}, {0.2, 0.2, 1});
+  ASSERT_TRUE(r.collides);
+  EXPECT_EQ(r.toi, 0.0);
+  // On a corner and on an edge of the triangle.
+  EXPECT_TRUE(vf_static_triangle({1, 0, 0}, {3, 3, 3}).collides);
+  EXPECT_TRUE(vf_static_triangle({0.5, 0.5, 0}, {3, 3, 3}).collides);
+}
+
+TEST(CcdKernel, VertexContactAtEnd) {
+  const CcdResult r = vf_static_triangle({0.2, 0.2, 1}, {0.2, 0.2, 0});
+  ASSERT_TRUE(r.collides);
+  EXPECT_LE(r.toi, 1.0);
+  EXPECT_GE(r.toi, 1.0 - kToiSlack);
+  // Reaching a corner exactly at t = 1.
+  EXPECT_TRUE(vf_static_triangle({0, 1, 1}, {0, 1, 0}).collides);
+}
+
+TEST(CcdKernel, CoplanarSliding) {
+  // In the triangle's plane, entering the triangle at x = 0, i.e. t = 1/3.
+  const CcdResult r = vf_static_triangle({-1, 0.2, 0}, {2, 0.2, 0});
+  ASSERT_TRUE(r.collides);
+  EXPECT_LE(r.toi, 1.0 / 3.0);
+  EXPECT_GE(r.toi, 1.0 / 3.0 - kToiSlack);
+  // In the plane, but passing outside it.
+  EXPECT_FALSE(vf_static_triangle({-1, 2, 0}, {2, 2, 0}).collides);
+}
+
+TEST(CcdKernel, NoMotion) {
+  EXPECT_TRUE(vf_static_triangle({0.3, 0.3, 0}, {0.3, 0.3, 0}).collides);
+  EXPECT_FALSE(vf_static_triangle({0.3, 0.3, 0.1}, {0.3, 0.3, 0.1}).collides);
+  const P4 e{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.5, -1, 0), Vec3(0.5, 1, 0)};
+  EXPECT_TRUE(edge_edge_ccd(e, e).collides);
+  const P4 f{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.5, -1, 0.1), Vec3(0.5, 1, 0.1)};
+  EXPECT_FALSE(edge_edge_ccd(f, f).collides);
+}
+
+TEST(CcdKernel, BothMoving) {
+  // The triangle rises from z = 0 to z = 1 while the vertex falls from 1 to 0: meet at 0.5.
+  const Vec3 up(0, 0, 1);
+  const CcdResult r = vertex_face_ccd(P4{Vec3(0.25, 0.25, 1), kA, kB, kC},
+                                      P4{Vec3(0.25, 0.25, 0), kA + up, kB + up, kC + up});
+  ASSERT_TRUE(r.collides);
+  EXPECT_LE(r.toi, 0.5);
+  EXPECT_GE(r.toi, 0.5 - kToiSlack);
+  // Same motion, vertex moving with the triangle: never touch.
+  EXPECT_FALSE(vertex_face_ccd(P4{Vec3(0.25, 0.25, 0.5), kA, kB, kC},
+                               P4{Vec3(0.25, 0.25, 1.5), kA + up, kB + up, kC + up})
+                   .collides);
+}
+
+TEST(CcdKernel, DegenerateTriangle) {
+  // Collinear corners: the "triangle" is the segment [0, 2] on the x axis.
+  const Vec3 a(0, 0, 0), b(1, 0, 0), c(2, 0, 0);
+  EXPECT_TRUE(vertex_face_ccd(P4{Vec3(1.5, -1, 0), a, b, c}, P4{Vec3(1.5, 1, 0), a, b, c}).collides);
+  EXPECT_FALSE(vertex_face_ccd(P4{Vec3(1.5, -1, 0.1), a, b, c}, P4{Vec3(1.5, 1, 0.1), a, b, c}).collides);
+  EXPECT_FALSE(vertex_face_ccd(P4{Vec3(2.5, -1, 0), a, b, c}, P4{Vec3(2.5, 1, 0), a, b, c}).collides);
+  // All three corners at one point: hit only through that point.
+  const Vec3 o(1, 1, 1);
+  EXPECT_TRUE(vertex_face_ccd(P4{Vec3(0, 0, 0), o, o, o}, P4{Vec3(2, 2, 2), o, o, o}).collides);
+  EXPECT_FALSE(vertex_face_ccd(P4{Vec3(0, 0, 0.1), o, o, o}, P4{Vec3(2, 2, 2.1), o, o, o}).collides);
+}
+
+TEST(CcdKernel, CrossingEdges) {
+  const Vec3 a0(0, 0, 0), a1(1, 0, 0);
+  const CcdResult r = edge_edge_ccd(P4{a0, a1, Vec3(0.5, -1, 1), Vec3(0.5, 1, 1)},
+                                    P4{a0, a1, Vec3(0.5, -1, -1), Vec3(0.5, 1, -1)});
+  ASSERT_TRUE(r.collides);
+  EXPECT_LE(r.toi, 0.5);
+  EXPECT_GE(r.toi, 0.5 - kToiSlack);
+  // Passing beyond the end of edge a.
+  EXPECT_FALSE(edge_edge_ccd(P4{a0, a1, Vec3(1.5, -1, 1), Vec3(1.5, 1, 1)},
+                             P4{a0, a1, Vec3(1.5, -1, -1), Vec3(1.5, 1, -1)})
+                   .collides);
+}
+
+TEST(CcdKernel, ParallelEdges) {
+  const Vec3 a0(0, 0, 0), a1(1, 0, 0);
+  // Parallel, overlapping in x in [0.5, 1], dropping through: contact at t = 0.5.
+  const CcdResult r = edge_edge_ccd(P4{a0, a1, Vec3(0.5, 0, 1), Vec3(1.5, 0, 1)},
+                                    P4{a0, a1, Vec3(0.5, 0, -1), Vec3(1.5, 0, -1)});
+  ASSERT_TRUE(r.collides);
+  EXPECT_LE(r.toi, 0.5);
+  EXPECT_GE(r.toi, 0.5 - kToiSlack);
+  // Parallel, offset by 0.1 in y: never touch.
+  EXPECT_FALSE(edge_edge_ccd(P4{a0, a1, Vec3(0.5, 0.1, 1), Vec3(1.5, 0.1, 1)},
+                             P4{a0, a1, Vec3(0.5, 0.1, -1), Vec3(1.5, 0.1, -1)})
+                   .collides);
+  // Collinear, sliding toward each other along the x axis: touch when b0 reaches a1 (t = 0.5).
+  const CcdResult s = edge_edge_ccd(P4{a0, a1, Vec3(2, 0, 0), Vec3(3, 0, 0)},
+                                    P4{a0, a1, Vec3(0, 0, 0), Vec3(1, 0, 0)});
+  ASSERT_TRUE(s.collides);
+  EXPECT_LE(s.toi, 0.5);
+  EXPECT_GE(s.toi, 0.5 - kToiSlack);
+}
+
+TEST(CcdKernel, EdgeContactAtEnds) {
+  const Vec3 a0(0, 0, 0), a1(1, 0, 0);
+  // Touching at t = 0 (b0 on a), then leaving.
+  const CcdResult r0 = edge_edge_ccd(P4{a0, a1, Vec3(0.5, 0, 0), Vec3(0.5, 1, 0)},
+                                     P4{a0, a1, Vec3(0.5, 0, 1), Vec3(0.5, 1, 1)});
+  ASSERT_TRUE(r0.collides);
+  EXPECT_EQ(r0.toi, 0.0);
+  // Arriving exactly at t = 1.
+  const CcdResult r1 = edge_edge_ccd(P4{a0, a1, Vec3(0.5, -1, 1), Vec3(0.5, 1, 1)},
+                                     P4{a0, a1, Vec3(0.5, -1, 0), Vec3(0.5, 1, 0)});
+  ASSERT_TRUE(r1.collides);
+  EXPECT_GE(r1.toi, 1.0 - kToiSlack);
+  // Endpoint to endpoint at t = 1.
+  EXPECT_TRUE(edge_edge_ccd(P4{a0, a1, Vec3(2, 1, 0), Vec3(3, 1, 0)},
+                            P4{a0, a1, Vec3(1, 0, 0), Vec3(2, 0, 0)})
+                  .collides);
+}
+
+TEST(CcdKernel, DegenerateEdge) {
+  const Vec3 a0(0, 0, 0), a1(1, 0, 0);
+  // Edge b is a single point passing through edge a, and beside it.
+  EXPECT_TRUE(edge_edge_ccd(P4{a0, a1, Vec3(0.3, 0, 1), Vec3(0.3, 0, 1)},
+                            P4{a0, a1, Vec3(0.3, 0, -1), Vec3(0.3, 0, -1)})
+                  .collides);
+  EXPECT_FALSE(edge_edge_ccd(P4{a0, a1, Vec3(0.3, 0.01, 1), Vec3(0.3, 0.01, 1)},
+                             P4{a0, a1, Vec3(0.3, 0.01, -1), Vec3(0.3, 0.01, -1)})
+                   .collides);
+}
+
+TEST(CcdKernel, NonFiniteInputIsConservative) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const CcdResult r = vf_static_triangle({nan, 0, 0}, {0, 0, 0});
+  EXPECT_TRUE(r.collides);
+  EXPECT_EQ(r.toi, 0.0);
+}
+
+// Random queries that collide at a chosen time t*: positions at t* are made to coincide (up
+// to rounding, far below δ), so the answer must be "collides" with toi <= t* (+ rounding).
+TEST(CcdKernel, RandomCollidingQueries) {
+  test::Rng rng(20240611);
+  auto rnd = [&] { return Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)); };
+  int limit_hits = 0;
+  for (int q = 0; q < 2000; ++q) {
+    const int tcase = q % 10;
+    const double ts = tcase == 0 ? 0.0 : tcase == 1 ? 1.0 : rng.uniform(0, 1);
+    P4 s{rnd(), rnd(), rnd(), rnd()}, e{rnd(), rnd(), rnd(), rnd()};
+    const bool vf = q % 2 == 0;
+    double u = rng.uniform(0, 1), v = rng.uniform(0, 1);
+    if (vf && u + v > 1) {
+      u = 1 - u;
+      v = 1 - v;
+    }
+    auto at = [&](int i) { return Vec3(s[static_cast<size_t>(i)] + ts * (e[static_cast<size_t>(i)] - s[static_cast<size_t>(i)])); };
+    // Move point 0 (the vertex, or a0 with a1 translated along) so it meets the target at ts.
+    Vec3 target;
+    if (vf) {
+      target = at(1) + u * (at(2) - at(1)) + v * (at(3) - at(1));
+    } else {
+      target = at(2) + v * (at(3) - at(2));  // a point of edge b at ts
+    }
+    // Choose point 0's position at ts to be target (edge–edge: a's point at parameter u).
+    const Vec3 shift = vf ? Vec3(target - at(0)) : Vec3(target - (at(0) + u * (at(1) - at(0))));
+    s[0] += shift;
+    e[0] += shift;
+    if (!vf) {
+      s[1] += shift;
+      e[1] += shift;
+    }
+    const CcdResult r = vf ? vertex_face_ccd(s, e) : edge_edge_ccd(s, e);
+    ASSERT_TRUE(r.collides) << "query " << q << " t* " << ts;
+    EXPECT_LE(r.toi, ts + 1e-9) << "query " << q;
+    limit_hits += r.hit_limit;
+  }
+  std::printf("[          ] random colliding queries: 2000, box-limit hits: %d\n", limit_hits);
+}
+
+// Random queries kept apart: the vertex / edge b stay above z = 0.1 while the triangle / edge a
+// stay below z = 0: never a collision, and with a gap of 0.1 not even a near miss.
+TEST(CcdKernel, RandomSeparatedQueries) {
+  test::Rng rng(77);
+  auto below = [&] { return Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 0)); };
+  auto above = [&] { return Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(0.1, 1)); };
+  for (int q = 0; q < 2000; ++q) {
+    if (q % 2 == 0) {
+      const P4 s{above(), below(), below(), below()}, e{above(), below(), below(), below()};
+      ASSERT_FALSE(vertex_face_ccd(s, e).collides) << q;
+    } else {
+      const P4 s{below(), below(), above(), above()}, e{below(), below(), above(), above()};
+      ASSERT_FALSE(edge_edge_ccd(s, e).collides) << q;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace vproxq

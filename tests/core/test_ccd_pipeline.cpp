@@ -1,0 +1,185 @@
+// The CCD pipeline (core/query/ccd.hpp) against its brute-force twin on seeded random steps:
+// identical vertex–face and edge–edge lists (ids and TOIs), per-pair summaries, independent of
+// the thread count and of Stage II (voxel culling at several grid resolutions); skipping of
+// objects whose topology changes; the exclusions of incident primitive pairs.
+#include <gtest/gtest.h>
+
+#include "core/geometry/ccd.hpp"
+#include "core/query/ccd.hpp"
+#include "core/voronoi/ccd_stage2.hpp"
+#include "support/random_scene.hpp"
+
+#include <cstdio>
+
+namespace vproxq {
+namespace {
+
+/// Frame k+1 for `from`: every vertex moved by a per-object drift plus a random jitter of up
+/// to `jitter`, so objects sweep into each other and fold onto themselves.
+Frame moved(const Frame& from, std::uint64_t seed, double drift, double jitter) {
+  test::Rng rng(seed);
+  Frame to;
+  to.index = from.index + 1;
+  for (const Object& o : from.objects) {
+    Object m = o;  // shares the topology pointer
+    const Vec3 d(rng.uniform(-drift, drift), rng.uniform(-drift, drift), rng.uniform(-drift, drift));
+    for (Vec3& p : m.positions)
+      p += d + Vec3(rng.uniform(-jitter, jitter), rng.uniform(-jitter, jitter), rng.uniform(-jitter, jitter));
+    to.objects.push_back(std::move(m));
+  }
+  return to;
+}
+
+void expect_same(const CcdStepResult& a, const CcdStepResult& b) {
+  ASSERT_EQ(a.vf.size(), b.vf.size());
+  for (size_t k = 0; k < a.vf.size(); ++k) {
+    EXPECT_EQ(a.vf[k].object_v, b.vf[k].object_v);
+    EXPECT_EQ(a.vf[k].vertex, b.vf[k].vertex);
+    EXPECT_EQ(a.vf[k].object_f, b.vf[k].object_f);
+    EXPECT_EQ(a.vf[k].face, b.vf[k].face);
+    EXPECT_EQ(a.vf[k].toi, b.vf[k].toi);
+  }
+  ASSERT_EQ(a.ee.size(), b.ee.size());
+  for (size_t k = 0; k < a.ee.size(); ++k) {
+    EXPECT_EQ(a.ee[k].object_a, b.ee[k].object_a);
+    EXPECT_EQ(a.ee[k].edge_a, b.ee[k].edge_a);
+    EXPECT_EQ(a.ee[k].object_b, b.ee[k].object_b);
+    EXPECT_EQ(a.ee[k].edge_b, b.ee[k].edge_b);
+    EXPECT_EQ(a.ee[k].toi, b.ee[k].toi);
+  }
+  ASSERT_EQ(a.pairs.size(), b.pairs.size());
+  for (size_t k = 0; k < a.pairs.size(); ++k) {
+    EXPECT_EQ(a.pairs[k].objects, b.pairs[k].objects);
+    EXPECT_EQ(a.pairs[k].toi, b.pairs[k].toi);
+    EXPECT_EQ(a.pairs[k].primitive_pairs, b.pairs[k].primitive_pairs);
+  }
+  ASSERT_EQ(a.skipped.size(), b.skipped.size());
+  for (size_t k = 0; k < a.skipped.size(); ++k) {
+    EXPECT_EQ(a.skipped[k].object, b.skipped[k].object);
+    EXPECT_EQ(a.skipped[k].reason, b.skipped[k].reason);
+  }
+}
+
+TEST(CcdPipeline, RandomStepsEqualBruteForceWithEveryCulling) {
+  std::uint64_t inter = 0, intra = 0, tests_off = 0, tests_vox = 0, brute_tests = 0;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    Frame from = test::make_random_frame(seed, 5, 3.0, 1);
+    from.index = 0;
+    const Frame to = moved(from, seed * 31, 0.6, seed % 2 ? 0.25 : 0.05);
+    const CcdStepResult ref = continuous_collisions_brute_force(from, to);
+    EXPECT_EQ(ref.counters.limit_hits, 0u);
+    brute_tests += ref.counters.elementary_tests();
+    for (const auto& p : ref.pairs) (p.objects[0] == p.objects[1] ? intra : inter) += p.primitive_pairs;
+    for (int threads : {1, 3}) {
+      const CcdStepResult r = continuous_collisions(from, to, CcdOptions{threads, nullptr});
+      expect_same(r, ref);
+      if (threads == 1) tests_off += r.counters.elementary_tests();
+      const CcdSweep sweep = CcdSweep::compute(from, to, threads);
+      for (int grid : {4, 16, 64}) {
+        SCOPED_TRACE("grid " + std::to_string(grid));
+        const CcdVoxelCulling voxels(from, to, sweep, grid, threads);
+        const CcdStepResult v = continuous_collisions(from, to, sweep, CcdOptions{threads, &voxels});
+        expect_same(v, ref);
+        if (threads == 1 && grid == 64) tests_vox += v.counters.elementary_tests();
+      }
+    }
+  }
+  // The scenes must exercise both kinds of collision, or the comparison proves little.
+  EXPECT_GT(inter, 0u);
+  EXPECT_GT(intra, 0u);
+  std::printf("[          ] colliding primitive pairs: inter %llu, intra %llu; elementary tests: "
+              "brute force %llu, AABB culling %llu, voxels (grid 64) %llu\n",
+              static_cast<unsigned long long>(inter), static_cast<unsigned long long>(intra),
+              static_cast<unsigned long long>(brute_tests), static_cast<unsigned long long>(tests_off),
+              static_cast<unsigned long long>(tests_vox));
+}
+
+TEST(CcdPipeline, TriangleSoupsEqualBruteForce) {
+  // Soups: no shared vertices, so every triangle pair's 15 primitive pairs are candidates.
+  test::Rng rng(5);
+  Frame from;
+  for (int i = 0; i < 3; ++i)
+    from.objects.push_back(test::make_soup(rng, Vec3(i * 0.5, 0, 0), 0.6, 0.3, 40, "soup" + std::to_string(i)));
+  const Frame to = moved(from, 9, 0.4, 0.2);
+  const CcdStepResult ref = continuous_collisions_brute_force(from, to);
+  EXPECT_GT(ref.vf.size() + ref.ee.size(), 0u);
+  expect_same(continuous_collisions(from, to, CcdOptions{2, nullptr}), ref);
+  const CcdSweep sweep = CcdSweep::compute(from, to, 2);
+  const CcdVoxelCulling voxels(from, to, sweep, 32, 2);
+  expect_same(continuous_collisions(from, to, sweep, CcdOptions{2, &voxels}), ref);
+}
+
+TEST(CcdPipeline, LargeCoordinateOffsetEqualsBruteForce) {
+  Frame from = test::make_random_frame(11, 4, 2.5, 1);
+  for (Object& o : from.objects)
+    for (Vec3& p : o.positions) p += Vec3(1e5, -2e5, 3e5);
+  const Frame to = moved(from, 12, 0.5, 0.2);
+  const CcdStepResult ref = continuous_collisions_brute_force(from, to);
+  EXPECT_GT(ref.vf.size() + ref.ee.size(), 0u);
+  const CcdSweep sweep = CcdSweep::compute(from, to, 2);
+  const CcdVoxelCulling voxels(from, to, sweep, 48, 2);
+  expect_same(continuous_collisions(from, to, sweep, CcdOptions{2, &voxels}), ref);
+}
+
+TEST(CcdPipeline, TopologyChangeAndMissingObjectAreSkipped) {
+  Frame from = test::make_random_frame(3, 3, 2.0, 1);
+  Frame to = moved(from, 4, 0.5, 0.1);
+  to.index = 1;
+  // Object 1 fractures: a copied topology with one face dropped.
+  auto topo = std::make_shared<Topology>(*to.objects[1].topology);
+  topo->faces.pop_back();
+  to.objects[1].topology = topo;
+  // Object 2 keeps equal faces in a different Topology instance: not a change.
+  to.objects[2].topology = std::make_shared<Topology>(*from.objects[2].topology);
+  // A fourth object in frame 0 has no counterpart in frame 1.
+  test::Rng rng(1);
+  from.objects.push_back(test::make_blob(rng, Vec3(0, 0, 0), 0.5, 1, 0.1, "extra"));
+  const CcdStepResult r = continuous_collisions(from, to, CcdOptions{2, nullptr});
+  ASSERT_EQ(r.skipped.size(), 2u);
+  EXPECT_EQ(r.skipped[0].object, 1);
+  EXPECT_NE(r.skipped[0].reason.find("topology changes"), std::string::npos) << r.skipped[0].reason;
+  EXPECT_EQ(r.skipped[1].object, 3);
+  EXPECT_NE(r.skipped[1].reason.find("no counterpart"), std::string::npos) << r.skipped[1].reason;
+  for (const auto& h : r.vf) {
+    EXPECT_NE(h.object_v, 1);
+    EXPECT_NE(h.object_f, 1);
+    EXPECT_NE(h.object_v, 3);
+  }
+  expect_same(r, continuous_collisions_brute_force(from, to));
+  EXPECT_EQ(r.to_frame, 1);
+}
+
+TEST(CcdPipeline, IncidentPairsAreExcludedButNeighboursAreTested) {
+  // Two triangles sharing vertex 0; the tip of the second (vertex 3) swings through the first.
+  auto topo = std::make_shared<Topology>();
+  topo->num_vertices = 4;
+  topo->faces = {{0, 1, 2}, {0, 2, 3}};
+  Object a;
+  a.name = "hinge";
+  a.topology = topo;
+  a.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0.4, 0.3, 1)};
+  Object b = a;
+  b.positions[3] = Vec3(0.3, 0.2, -1);
+  Frame from, to;
+  from.objects = {a};
+  to.objects = {b};
+  to.index = 1;
+  const CcdStepResult r = continuous_collisions(from, to, CcdOptions{1, nullptr});
+  // Vertex 3 crosses face 0 (it is not a corner of it): reported although the triangles are
+  // adjacent. The incident pairs (vertex 0 or 2 against face 0, edges sharing a vertex) are not.
+  ASSERT_EQ(r.vf.size(), 1u);
+  EXPECT_EQ(r.vf[0].vertex, 3);
+  EXPECT_EQ(r.vf[0].face, 0);
+  EXPECT_GT(r.vf[0].toi, 0.45);
+  EXPECT_LE(r.vf[0].toi, 0.5);
+  // The only edge pair without a shared vertex is (1-2, 0-3); edge 0-3 sweeps through the
+  // plane z = 0 only at points with x + y <= 0.7, never reaching edge 1-2 (x + y = 1).
+  EXPECT_TRUE(r.ee.empty());
+  expect_same(r, continuous_collisions_brute_force(from, to));
+  ASSERT_EQ(r.pairs.size(), 1u);
+  EXPECT_EQ(r.pairs[0].objects, (std::array<Index, 2>{0, 0}));
+}
+
+}  // namespace
+}  // namespace vproxq
