@@ -177,24 +177,25 @@ Json frame_json(const FrameResult& frame, double write_ms) {
     objects.push_back(std::move(r));
   }
   j["objects"] = std::move(objects);
+  // Key order as in DESIGN.md: distance {inter, intra, intersecting_pairs}, ccd, pd, stats.
   if (frame.inter) {
     Json inter = Json::array();
     for (const InterObjectDistance& d : *frame.inter) inter.push_back(inter_json(d));
     j["distance"]["inter"] = std::move(inter);
-    if (frame.intersecting_pairs)
-      j["distance"]["intersecting_pairs"] = frame.intersecting_pairs->size();
-  }
-  if (frame.pd) {
-    Json pd = Json::array();
-    for (const PenetrationDepth& p : *frame.pd) pd.push_back(pd_json(p));
-    j["pd"] = std::move(pd);
   }
   if (frame.intra) {
     Json intra = Json::array();
     for (const IntraObjectDistance& d : *frame.intra) intra.push_back(intra_json(d));
     j["distance"]["intra"] = std::move(intra);
   }
+  if (frame.inter && frame.intersecting_pairs)
+    j["distance"]["intersecting_pairs"] = frame.intersecting_pairs->size();
   if (frame.ccd) j["ccd"] = ccd_json(*frame.ccd);
+  if (frame.pd) {
+    Json pd = Json::array();
+    for (const PenetrationDepth& p : *frame.pd) pd.push_back(pd_json(p));
+    j["pd"] = std::move(pd);
+  }
   const StageTimes& t = frame.time_ms;
   Json time_ms;
   time_ms["load"] = t.load;
