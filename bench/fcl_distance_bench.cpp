@@ -1,7 +1,7 @@
 // vproxq-bench-fcl: per-frame inter-object distance (every object's nearest other object and
 // the separation distance), vproxq against FCL 0.7, on the frames of a scene.
 //
-//   vproxq-bench-fcl bench-out/scene.json --threads 2 --frames 0:5 --repeat 3
+//   vproxq-bench-fcl bench-out/scene.json --threads 2 --frames 0:5 --repeat 3 [--json out.json]
 //
 // For each frame, with the frame already loaded (loading is not timed):
 //   vproxq  inter_object_distance(frame, {threads}).
@@ -202,7 +202,44 @@ struct Options {
   std::optional<int> fcl_threads;
   std::string frames;  ///< "A:B", "A:", ":B" or "A"; empty: all
   int repeat = 3;
+  std::string json;  ///< also write the per-frame numbers here (for vproxq-report)
 };
+
+/// One frame's numbers, for --json.
+struct FrameTiming {
+  std::size_t frame = 0, objects = 0;
+  long long triangles = 0, touching = 0;
+  double vproxq_ms = 0, fcl_build_ms = 0, fcl_query_ms = 0;
+  int mismatches = 0;
+};
+
+/// Writes --json: {"fcl_version", "threads", "fcl_threads", "repeat", "frames": [...]}, via a
+/// temporary file and a rename, so a reader never sees half of it.
+void write_json(const Options& opt, int fcl_threads, const std::vector<FrameTiming>& rows) {
+  std::string text = "{\n  \"tool\": \"vproxq-bench-fcl\",\n  \"fcl_version\": \"" FCL_VERSION "\",\n";
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "  \"threads\": %d,\n  \"fcl_threads\": %d,\n  \"repeat\": %d,\n  \"frames\": [",
+                opt.threads, fcl_threads, opt.repeat);
+  text += line;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const FrameTiming& r = rows[i];
+    std::snprintf(line, sizeof line,
+                  "%s\n    {\"frame\": %zu, \"objects\": %zu, \"triangles\": %lld, "
+                  "\"touching\": %lld, \"vproxq_ms\": %.17g, \"fcl_build_ms\": %.17g, "
+                  "\"fcl_query_ms\": %.17g, \"mismatches\": %d}",
+                  i ? "," : "", r.frame, r.objects, r.triangles, r.touching, r.vproxq_ms,
+                  r.fcl_build_ms, r.fcl_query_ms, r.mismatches);
+    text += line;
+  }
+  text += "\n  ]\n}\n";
+  const std::string tmp = opt.json + ".tmp";
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f || std::fwrite(text.data(), 1, text.size(), f) != text.size() || std::fclose(f) != 0)
+    throw vproxq::RuntimeError("cannot write " + tmp);
+  if (std::rename(tmp.c_str(), opt.json.c_str()) != 0)
+    throw vproxq::RuntimeError("cannot rename " + tmp + " to " + opt.json);
+}
 
 /// Parses --frames into [first, last) within [0, count). Throws UsageError.
 std::pair<std::size_t, std::size_t> frame_range(const std::string& spec, std::size_t count) {
@@ -247,6 +284,7 @@ int run(const Options& opt) {
   double sum_v = 0, sum_b = 0, sum_q = 0, sum_t = 0, sum_ratio = 0;
   long long sum_tris = 0;
   int frames = 0, mismatches = 0, ties = 0;
+  std::vector<FrameTiming> rows;
   for (std::size_t k = first; k < last; ++k) {
     const vproxq::Frame frame = scene.load_frame(k);
     long long tris = 0;
@@ -282,6 +320,8 @@ int run(const Options& opt) {
                 frame.objects.size(), tris, touching, best_v, best_f.build_ms, best_f.query_ms,
                 best_f.total_ms(), ratio, a.mismatches);
     std::fflush(stdout);
+    rows.push_back({k, frame.objects.size(), tris, static_cast<long long>(touching), best_v,
+                    best_f.build_ms, best_f.query_ms, a.mismatches});
     sum_v += best_v;
     sum_b += best_f.build_ms;
     sum_q += best_f.query_ms;
@@ -296,6 +336,7 @@ int run(const Options& opt) {
   std::printf("(mean ratio = mean FCL total / mean vproxq; per-frame ratios average %.2f)\n",
               sum_ratio / frames);
   std::printf("touching: objects at distance 0 (touching or overlapping another)\n");
+  if (!opt.json.empty()) write_json(opt, fcl_threads, rows);
   if (ties > 0)
     std::printf("%d object(s) with a different nearest object at the same distance (ties: FCL "
                 "stops at the first touching object, vproxq reports the smallest id)\n",
@@ -326,6 +367,8 @@ int main(int argc, char** argv) {
   app.add_option("--repeat", opt.repeat, "runs per frame and side; the fastest is reported")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
+  app.add_option("--json", opt.json,
+                 "also write the per-frame timings to this JSON file (read by vproxq-report)");
   try {
     app.parse(argc, argv);
     return run(opt);
@@ -337,6 +380,9 @@ int main(int argc, char** argv) {
   } catch (const vproxq::InputError& e) {
     std::cerr << "vproxq-bench-fcl: error: " << e.what() << "\n";
     return vproxq::exit_code::kInput;
+  } catch (const vproxq::RuntimeError& e) {
+    std::cerr << "vproxq-bench-fcl: error: " << e.what() << "\n";
+    return vproxq::exit_code::kRuntime;
   } catch (const std::exception& e) {
     std::cerr << "vproxq-bench-fcl: error: " << e.what() << "\n";
     return vproxq::exit_code::kRuntime;

@@ -8,16 +8,21 @@
 #include "core/errors.hpp"
 #include "sample_scenes/generators/blobs.hpp"
 #include "sample_scenes/generators/scene_files.hpp"
+#include "sample_scenes/generators/sim_scenes.hpp"
 
 #include <CLI/CLI.hpp>
 
 #include <charconv>
+#include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <optional>
 #include <string>
+#include <tuple>
+#include <vector>
 
 namespace fs = std::filesystem;
 using namespace vproxq;
@@ -127,6 +132,52 @@ void run_blobs(BlobsCommand cmd) {
   std::printf("wrote %s (%d frames)\n", scene_file.string().c_str(), opt.frames);
 }
 
+/// A simulated scene's subcommand: its size options, plus --frames, --seed and --out.
+struct SimCommand {
+  std::string name;
+  int* frames = nullptr;
+  std::uint64_t* seed = nullptr;
+  std::vector<std::pair<std::string, int*>> sizes;  ///< (option name, value), in order
+  fs::path out;
+  std::function<void(SceneWriter&)> generate;
+  CLI::App* app = nullptr;
+};
+
+/// The arguments that reproduce the files (no --out), written into every OBJ header.
+std::string canonical_command(const SimCommand& cmd) {
+  std::string s = "vproxq-gen " + cmd.name;
+  for (const auto& [option, value] : cmd.sizes) s += " --" + option + " " + std::to_string(*value);
+  s += " --frames " + std::to_string(*cmd.frames) + " --seed " + std::to_string(*cmd.seed);
+  return s;
+}
+
+void run_sim(const SimCommand& cmd) {
+  const std::string command = canonical_command(cmd);
+  std::printf("%s\n", command.c_str());
+  const auto t0 = std::chrono::steady_clock::now();
+  SceneWriter writer(cmd.out, cmd.name, command, *cmd.frames);
+  cmd.generate(writer);
+  const double s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::printf("generated in %.1f s\n", s);
+}
+
+void add_sim_options(SimCommand& cmd,
+                     const std::vector<std::tuple<std::string, int*, long long, long long,
+                                                  std::string>>& sizes) {
+  for (const auto& [option, value, lo, hi, help] : sizes) {
+    cmd.app->add_option("--" + option, *value, help)->check(int_in(lo, hi))->capture_default_str();
+    cmd.sizes.emplace_back(option, value);
+  }
+  cmd.app->add_option("--frames", *cmd.frames, "number of frames (1: the start state only)")
+      ->check(int_in(1, 100'000))
+      ->capture_default_str();
+  cmd.app->add_option("--seed", *cmd.seed, "random seed")->check(seed_value())->capture_default_str();
+  cmd.app->add_option("--out", cmd.out,
+                      "output folder (created if missing; files of the same names are replaced)")
+      ->required();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -163,8 +214,81 @@ int main(int argc, char** argv) {
                   "output folder (created if missing; files of the same names are replaced)")
       ->required();
 
+  // The paper's five benchmarks, simulated (position-based dynamics, see sim_scenes.hpp).
+  SkirtOptions skirt;
+  ClothBallOptions cloth_ball;
+  BowlOptions bowl;
+  FunnelOptions funnel;
+  BreakingOptions breaking;
+  std::vector<SimCommand> sims(5);
+  sims[0].name = "skirt";
+  sims[0].app = app.add_subcommand(
+      "skirt",
+      "Benchmark 1: a flared skirt of cloth (self-colliding) hanging from the waist of a body "
+      "that twists and sways, over two swinging legs (capsules, written as objects). "
+      "Default 12,000 cloth triangles + 2 legs, 40 frames over 2.5 s.");
+  sims[0].frames = &skirt.frames;
+  sims[0].seed = &skirt.seed;
+  add_sim_options(sims[0], {{"segments", &skirt.segments, 8, 4096, "vertices around the skirt"},
+                            {"rings", &skirt.rings, 3, 4096,
+                             "vertex rings waist to hem: 2*segments*(rings-1) triangles"}});
+  sims[0].generate = [&](SceneWriter& w) { generate_skirt(skirt, w); };
+
+  sims[1].name = "cloth-ball";
+  sims[1].app = app.add_subcommand(
+      "cloth-ball",
+      "Benchmark 2: a square cloth falling on a moving, spinning ball (an object) over the "
+      "ground (static): it wraps the ball and folds onto itself. Default 15,138 cloth "
+      "triangles + 320 ball triangles, 40 frames over 3 s.");
+  sims[1].frames = &cloth_ball.frames;
+  sims[1].seed = &cloth_ball.seed;
+  add_sim_options(sims[1], {{"resolution", &cloth_ball.resolution, 3, 4096,
+                             "cloth vertices per side: 2*(resolution-1)^2 triangles"}});
+  sims[1].generate = [&](SceneWriter& w) { generate_cloth_ball(cloth_ball, w); };
+
+  sims[2].name = "bowl";
+  sims[2].app = app.add_subcommand(
+      "bowl",
+      "Benchmark 3: soft letter-like shapes (tubes swept along strokes of \"siggraph06\") "
+      "falling into a bowl (static). Default 10 letters x 448 triangles, 40 frames over 3.5 s.");
+  sims[2].frames = &bowl.frames;
+  sims[2].seed = &bowl.seed;
+  add_sim_options(sims[2], {{"objects", &bowl.objects, 1, 10'000, "number of letters"},
+                            {"around", &bowl.around, 3, 256, "vertices around each tube"},
+                            {"along", &bowl.along, 3, 4096,
+                             "rings along each stroke: 2*around*along triangles per letter"}});
+  sims[2].generate = [&](SceneWriter& w) { generate_bowl(bowl, w); };
+
+  sims[3].name = "funnel";
+  sims[3].app = app.add_subcommand(
+      "funnel",
+      "Benchmark 4: soft letters crowding through a funnel onto a ramp (funnel, ramp and floor "
+      "static). Default 200 letters x 180 triangles, 40 frames over 3 s.");
+  sims[3].frames = &funnel.frames;
+  sims[3].seed = &funnel.seed;
+  add_sim_options(sims[3], {{"objects", &funnel.objects, 1, 100'000, "number of letters"},
+                            {"around", &funnel.around, 3, 256, "vertices around each tube"},
+                            {"along", &funnel.along, 3, 4096,
+                             "rings along each stroke: 2*around*along triangles per letter"}});
+  sims[3].generate = [&](SceneWriter& w) { generate_funnel(funnel, w); };
+
+  sims[4].name = "breaking";
+  sims[4].app = app.add_subcommand(
+      "breaking",
+      "Benchmark 5: objects pre-cut into box pieces, dropped on the ground (static); each "
+      "breaks into its pieces when it first touches the ground. One OBJ group per object, "
+      "split into pieces by \"objects\": \"components\". Default 14 objects, 39 pieces, "
+      "5,632 triangles before breaking, 40 frames over 2.5 s.");
+  sims[4].frames = &breaking.frames;
+  sims[4].seed = &breaking.seed;
+  add_sim_options(sims[4], {{"objects", &breaking.objects, 1, 10'000, "number of objects"},
+                            {"cells", &breaking.cells, 1, 64, "grid cells along a piece's side"}});
+  sims[4].generate = [&](SceneWriter& w) { generate_breaking(breaking, w); };
+
   try {
     app.parse(argc, argv);
+    for (const SimCommand& cmd : sims)
+      if (cmd.app->parsed()) run_sim(cmd);
     if (sub->parsed()) run_blobs(blobs);
     return exit_code::kOk;
   } catch (const CLI::ParseError& e) {
