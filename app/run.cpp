@@ -158,9 +158,13 @@ VoronoiFrameStats frame_stats(const SelfVoronoiBounds& b) {
 void run_intra(const Frame& frame, const FrameBoxes& boxes, VoronoiStage& voronoi, int grid,
                int threads, FrameResult& result) {
   Stopwatch sw;
+  // The 2-ring bounds are the intra query's Stage I (paper 5.2.2): they count as "aabb".
   const auto ring2 = ring2_upper_bounds(frame, threads);
+  result.time_ms.intra_bounds = sw.elapsed_ms();
+  result.time_ms.aabb += result.time_ms.intra_bounds;
   IntraDistanceOptions opts{threads, nullptr};
   SelfVoronoiBounds bounds;
+  sw.restart();
   if (voronoi.self_backend) {
     bounds = compute_self_voronoi_bounds(frame, boxes, ring2, *voronoi.self_backend, grid, threads);
     opts.voronoi = &bounds;

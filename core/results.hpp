@@ -61,8 +61,9 @@ struct DistanceCounters {
 /// Wall-clock milliseconds per stage.
 struct StageTimes {
   double load = 0, aabb = 0, voronoi = 0, exact = 0, write = 0, total = 0;
-  /// The intra-object query's share of voronoi (2-ring bounds + self Stage II) and of exact.
-  double intra_voronoi = 0, intra_exact = 0;
+  /// The intra-object query's shares: of aabb (its 2-ring bounds, paper 5.2.2), of voronoi
+  /// (self Stage II) and of exact (its Stage III).
+  double intra_bounds = 0, intra_voronoi = 0, intra_exact = 0;
 };
 
 /// What Stage II did on one frame (absent when it did not run).

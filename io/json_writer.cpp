@@ -205,6 +205,7 @@ Json frame_json(const FrameResult& frame, double write_ms) {
   time_ms["write"] = write_ms;
   time_ms["total"] = t.total;
   if (frame.intra) {
+    time_ms["intra_bounds"] = t.intra_bounds;
     time_ms["intra_voronoi"] = t.intra_voronoi;
     time_ms["intra_exact"] = t.intra_exact;
   }

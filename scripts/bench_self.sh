@@ -10,7 +10,7 @@
 #
 # Environment: MESH (tests/data/frames/cloth-funnel/frames/227.ply), THREADS (2), REPEAT (3),
 # GRIDS ("0 96 128 192 256 384"; 0 = the default self grid), BACKENDS ("off cpu gpu"),
-# VPROXQ (build/app/vproxq). Needs jq.
+# VPROXQ (build/app/vproxq). Needs jq (scripts/setup.sh --bench installs it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -23,13 +23,13 @@ vproxq=${VPROXQ:-build/app/vproxq}
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 
-# One run: prints "intra_voronoi_ms intra_exact_ms intra_exact_tests grid_x samples".
+# One run: prints "intra_bounds_ms + intra_voronoi_ms, intra_exact_ms intra_exact_tests grid_x samples".
 run_once() {
   local backend=$1 grid=$2
   local args=(--queries distance --voronoi="$backend" --threads "$threads" --quiet -o "$out/r")
   [ "$grid" != 0 ] && args+=(--grid "$grid")
   "$vproxq" "$mesh" "${args[@]}"
-  jq -r '.frames[0] | [.stats.time_ms.intra_voronoi, .stats.time_ms.intra_exact,
+  jq -r '.frames[0] | [.stats.time_ms.intra_bounds + .stats.time_ms.intra_voronoi, .stats.time_ms.intra_exact,
           .stats.intra_exact_tests, (.stats.self_voronoi.grid[0] // 0),
           (.stats.self_voronoi.samples // 0)] | @tsv' "$out/r/results.json"
 }

@@ -3,7 +3,7 @@
 # then configures and builds a Release tree in ./build. Idempotent: a second run only rebuilds.
 #   bash scripts/setup.sh            # packages + build
 #   bash scripts/setup.sh --no-build # packages only
-#   bash scripts/setup.sh --bench    # also the benchmark-only packages (FCL, gnuplot)
+#   bash scripts/setup.sh --bench    # also the benchmark-only packages (FCL, gnuplot, jq)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -25,7 +25,7 @@ packages=(
   libegl1 libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
 )
 if [ "$bench" = 1 ]; then
-  packages+=(libfcl-dev gnuplot-nox)
+  packages+=(libfcl-dev gnuplot-nox jq)
 fi
 
 missing=()
