@@ -150,6 +150,7 @@ struct Batch {
   std::size_t first = 0;
   std::size_t count = 0;
   std::optional<StorageBuffer> samples;
+  std::optional<StorageBuffer> exclude;
   std::optional<StorageBuffer> results;
 };
 
@@ -217,13 +218,17 @@ DvdOutput GlVoronoiBackend::compute(const DvdInput& in) {
     bin_offsets.emplace(StorageBuffer::from_vector(context_, in.bin_offsets));
     bin_tris.emplace(StorageBuffer::from_vector(context_, in.bin_tris));
     std::vector<std::uint32_t> samples;
+    std::vector<std::int32_t> exclude;
     for (Batch& batch : batches) {
       samples.resize(2 * batch.count);
+      exclude.assign(batch.count, kNoIndex);
       for (std::size_t k = 0; k < batch.count; ++k) {
         samples[2 * k] = static_cast<std::uint32_t>(in.voxels[batch.first + k]);
         std::memcpy(&samples[2 * k + 1], &in.band[batch.first + k], sizeof(float));
+        if (!in.exclude_site.empty()) exclude[k] = in.exclude_site[batch.first + k];
       }
       batch.samples.emplace(StorageBuffer::from_vector(context_, samples));
+      batch.exclude.emplace(StorageBuffer::from_vector(context_, exclude));
       batch.results.emplace(context_, 16 * batch.count, GL_STREAM_READ);
     }
   });
@@ -249,6 +254,7 @@ DvdOutput GlVoronoiBackend::compute(const DvdInput& in) {
     for (const Batch& batch : batches) {
       batch.samples->bind(4);
       batch.results->bind(5);
+      batch.exclude->bind(8);
       program_.set_uint("sample_count", static_cast<GLuint>(batch.count));
       dispatch(context_, program_, group_count(batch.count, static_cast<GLuint>(local_size)));
       ++last_dispatch_count_;

@@ -13,6 +13,8 @@
 //                             bits)
 //   binding 5  results        ivec4 per sample voxel of this batch: site1, site2, and the float
 //                             bits of dist1, dist2 (site -1 and dist = band when none)
+//   binding 8  exclude_sites  int per sample voxel of this batch: a site whose triangles are
+//                             ignored there (DvdInput::exclude_site), or -1
 // Uniforms: sample_count (this batch), cell, dims_x/y/z (grid), bin_size, bin_dims_x/y,
 // prefilter_margin (see below).
 // Defines: LOCAL_SIZE, the work group size (default 64).
@@ -28,6 +30,7 @@ layout(std430, binding = 2) readonly buffer BinOffsets { int bin_offsets[]; };
 layout(std430, binding = 3) readonly buffer BinTriangles { int bin_triangles[]; };
 layout(std430, binding = 4) readonly buffer Samples { uvec2 samples[]; };
 layout(std430, binding = 5) writeonly buffer Results { ivec4 results[]; };
+layout(std430, binding = 8) readonly buffer ExcludeSites { int exclude_sites[]; };
 
 uniform uint sample_count;
 uniform float cell;
@@ -141,6 +144,7 @@ void main() {
   }
   uint id = samples[i].x;
   float band = uintBitsToFloat(samples[i].y);
+  int skip = exclude_sites[i];
   uint dx = uint(dims_x);
   uint dy = uint(dims_y);
   ivec3 voxel = ivec3(int(id % dx), int((id / dx) % dy), int(id / (dx * dy)));
@@ -171,7 +175,7 @@ void main() {
           int t = bin_triangles[j];
           ivec4 info = triangle_info[t];
           // Visit a triangle once: in the first visited bin of its own range.
-          if (max(info.yzw, bin_lo) != here) {
+          if (max(info.yzw, bin_lo) != here || info.x == skip) {
             continue;
           }
           vec3 a = corner(t, 0);

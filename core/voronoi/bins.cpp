@@ -96,6 +96,8 @@ void validate_dvd_input(const DvdInput& in) {
   const std::size_t tris = in.tri_site.size();
   if (in.tri_xyz_d.size() != 9 * tris) fail("tri_xyz_d is not 9 numbers per triangle");
   if (in.band.size() != in.voxels.size()) fail("band and voxels differ in size");
+  if (!in.exclude_site.empty() && in.exclude_site.size() != in.voxels.size())
+    fail("exclude_site is neither empty nor one per voxel");
   if (in.bin_size < 1) fail("bin_size < 1 (call bin_triangles())");
   const std::size_t bins = static_cast<std::size_t>(in.bin_dims[0]) *
                            static_cast<std::size_t>(in.bin_dims[1]) *

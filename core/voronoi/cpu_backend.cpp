@@ -116,6 +116,7 @@ class CpuVoronoiBackend final : public DiscreteVoronoiBackend {
       const Vec3 q = grid.cell * Vec3(static_cast<double>(x) + 0.5, static_cast<double>(y) + 0.5,
                                       static_cast<double>(z) + 0.5);
       const double band = in.band[k];
+      const std::int32_t skip = in.exclude_site.empty() ? kNoIndex : in.exclude_site[k];
       const BinRange range = bins_within(in, q, band);
       TopTwo top;
       for (std::int32_t bz = range.lo[2]; bz <= range.hi[2]; ++bz) {
@@ -130,7 +131,7 @@ class CpuVoronoiBackend final : public DiscreteVoronoiBackend {
               for (std::size_t a = 0; a < 3; ++a) {
                 first_visit = first_visit && std::max(first_bin[t][a], range.lo[a]) == here[a];
               }
-              if (!first_visit) continue;
+              if (!first_visit || in.tri_site[t] == skip) continue;
               const double cutoff = std::min(band, top.d2) + slack;
               const double box_sq =
                   (box_lo[t] - q).cwiseMax(q - box_hi[t]).cwiseMax(0.0).squaredNorm();

@@ -40,6 +40,11 @@ struct DvdInput {
   /// larger than band[k] need not be exact (report any value >= band[k], e.g. band[k]).
   std::vector<std::int64_t> voxels;
   std::vector<float> band;
+  /// Per sample voxel (same order), or empty for "none anywhere": a site whose triangles the
+  /// backend ignores there, or -1. Stage II passes the voxel's only site when a single site
+  /// touches it: that site's own distance (about 0) is never used, only the nearest *other*
+  /// sites, and skipping its many nearby triangles is most of the backend's work.
+  std::vector<std::int32_t> exclude_site;
   /// Triangle binning: bins of bin_size x bin_size x bin_size voxels, bin_dims per axis;
   /// bin b's triangles are bin_tris[bin_offsets[b] .. bin_offsets[b+1]). A triangle is listed
   /// in every bin its bounding box overlaps. To find every triangle within distance r of a
@@ -50,8 +55,8 @@ struct DvdInput {
   std::vector<std::int32_t> bin_tris;
 };
 
-/// What a backend returns: per sample voxel (same order as DvdInput::voxels), the nearest
-/// site and the nearest site different from it, with distances (kNoIndex / band when none
+/// What a backend returns: per sample voxel (same order as DvdInput::voxels), among the sites
+/// other than its exclude_site, the nearest site and the nearest site different from it, with distances (kNoIndex / band when none
 /// within the band). Ties between sites go to the smaller site id.
 struct DvdOutput {
   std::vector<std::int32_t> site1, site2;

@@ -76,20 +76,33 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
 
   DvdInput in;
   in.grid = grid;
-  std::vector<std::pair<std::int64_t, float>> vb;
+  struct VoxelBand {
+    std::int64_t voxel;
+    float band;
+    std::int32_t object;
+  };
+  std::vector<VoxelBand> vb;
   size_t total_hits = 0;
   for (const auto& h : hits) total_hits += h.size();
   vb.reserve(total_hits);
   for (size_t i = 0; i < n; ++i)
-    for (const auto& h : hits[i]) vb.emplace_back(h.voxel, static_cast<float>(obj_band[i]));
-  std::sort(vb.begin(), vb.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& h : hits[i])
+      vb.push_back({h.voxel, static_cast<float>(obj_band[i]), static_cast<std::int32_t>(i)});
+  std::sort(vb.begin(), vb.end(), [](const auto& a, const auto& b) { return a.voxel < b.voxel; });
   for (size_t k = 0; k < vb.size();) {
     size_t e = k;
     float band = 0;
-    while (e < vb.size() && vb[e].first == vb[k].first) band = std::max(band, vb[e++].second);
-    in.voxels.push_back(vb[k].first);
+    bool one_site = true;
+    for (; e < vb.size() && vb[e].voxel == vb[k].voxel; ++e) {
+      band = std::max(band, vb[e].band);
+      one_site = one_site && vb[e].object == vb[k].object;
+    }
+    in.voxels.push_back(vb[k].voxel);
     // Round the float band up so that it is never below the double band.
     in.band.push_back(std::nextafter(band, std::numeric_limits<float>::infinity()));
+    // A voxel touched by one object only: the scan below reads the nearest site other than
+    // that object, which the backend finds faster without the object's own triangles.
+    in.exclude_site.push_back(one_site ? vb[k].object : kNoIndex);
     k = e;
   }
   out.sample_voxels = in.voxels.size();

@@ -107,6 +107,8 @@ DvdInput random_scene(unsigned seed, const SceneOptions& options) {
     if (k % 103 == 1) band = std::numeric_limits<float>::infinity();
     if (k % 107 == 2) band = 1e30f;
     in.band.push_back(band);
+    // Every third voxel ignores one site (as Stage II does for a voxel of a single object).
+    in.exclude_site.push_back(k % 3 == 0 ? pick_site(rng) : kNoIndex);
   }
   bin_triangles(in, options.bin_size);
   return in;
@@ -121,7 +123,9 @@ DvdOutput brute_force(const DvdInput& in) {
     const Vec3 q = sample_point(in.grid, in.voxels[k]);
     const double band = in.band[k];
     std::vector<double> best(static_cast<std::size_t>(site_count), kInfinity);
+    const std::int32_t skip = in.exclude_site.empty() ? kNoIndex : in.exclude_site[k];
     for (std::size_t t = 0; t < in.tri_site.size(); ++t) {
+      if (in.tri_site[t] == skip) continue;
       const double d = std::sqrt(point_triangle_distance(q, triangle_of(in, t)).squared_distance);
       double& b = best[static_cast<std::size_t>(in.tri_site[t])];
       if (d < band) b = std::min(b, d);

@@ -68,7 +68,9 @@ Reference reference(const DvdInput& in, bool use_bins = false) {
     const Vec3 q = sample_point(in.grid, in.voxels[k]);
     const double band = in.band[k];
     std::map<std::int32_t, double> best;
+    const std::int32_t skip = in.exclude_site.empty() ? kNoIndex : in.exclude_site[k];
     auto consider = [&](std::size_t t) {
+      if (in.tri_site[t] == skip) return;
       const double d = std::sqrt(point_triangle_distance(q, triangle_of(in, t)).squared_distance);
       if (d >= band) return;
       const auto [it, inserted] = best.emplace(in.tri_site[t], d);
@@ -213,6 +215,8 @@ DvdInput random_scene(unsigned seed, const SceneOptions& options) {
     if (k % 97 == 0) band = 0.0f;
     if (k % 89 == 1) band = std::numeric_limits<float>::infinity();
     in.band.push_back(band);
+    // Every third voxel ignores one site (as Stage II does for a voxel of a single object).
+    in.exclude_site.push_back(k % 3 == 0 ? pick_site(rng) : kNoIndex);
   }
   bin_triangles(in, 4);
   return in;
