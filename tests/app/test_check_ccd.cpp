@@ -2,7 +2,7 @@
 // against the library's kernel on the same file, and the error paths with their exit codes.
 #include "core/geometry/ccd.hpp"
 #include "io/ccd_queries.hpp"
-#include "support/process.hpp"
+#include "support/cli.hpp"
 
 #include <gtest/gtest.h>
 
@@ -16,11 +16,10 @@ namespace fs = std::filesystem;
 using test::quote;
 using test::run_command;
 using test::ScratchDir;
+using test::vproxq;
 
-const std::string kVproxq = VPROXQ_BINARY;
 const fs::path kQueries = fs::path(VPROXQ_TEST_DATA_DIR) / "ccd-queries";
 
-test::ProcessResult vproxq(const std::string& args) { return run_command(kVproxq + " " + args); }
 
 std::string last_line(const std::string& out) {
   std::string s = out;

@@ -2,7 +2,7 @@
 // force; runs are reproducible and `vproxq diff` says so.
 #include "core/query/inter_distance.hpp"
 #include "io/scene_source.hpp"
-#include "support/process.hpp"
+#include "support/cli.hpp"
 #include "support/random_scene.hpp"
 
 #include <gtest/gtest.h>
@@ -13,34 +13,20 @@
 namespace vproxq {
 namespace {
 
+using test::slurp;
+
 namespace fs = std::filesystem;
 using test::quote;
 using test::run_command;
 using test::ScratchDir;
+using test::read_json;
+using test::vproxq;
+using test::write_obj;
 
-const std::string kVproxq = VPROXQ_BINARY;
 const fs::path kSamples = VPROXQ_SAMPLE_SCENES_DIR;
 
-test::ProcessResult vproxq(const std::string& args) { return run_command(kVproxq + " " + args); }
 
-/// Writes a frame as one OBJ with an `o` group per object, 17 significant digits.
-void write_obj(const Frame& frame, const fs::path& file) {
-  std::ofstream out(file);
-  out.precision(17);
-  Index base = 1;
-  for (const Object& o : frame.objects) {
-    out << "o " << o.name << "\n";
-    for (const Vec3& p : o.positions) out << "v " << p.x() << " " << p.y() << " " << p.z() << "\n";
-    for (const Face& f : o.topology->faces)
-      out << "f " << f[0] + base << " " << f[1] + base << " " << f[2] + base << "\n";
-    base += o.num_vertices();
-  }
-}
 
-nlohmann::json read_json(const fs::path& p) {
-  std::ifstream in(p);
-  return nlohmann::json::parse(in);
-}
 
 /// Every frame of results.json equals the brute force on the frames the scene loads.
 void expect_results_equal_brute_force(const fs::path& scene_path, const fs::path& results) {
@@ -286,11 +272,6 @@ TEST(Cli, FrameRangeAndSummary) {
 namespace vproxq {
 namespace {
 
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 TEST(Generator, RegeneratesTheCommittedSampleSceneByteForByte) {
   ScratchDir dir;
   const auto r = run_command(std::string(VPROXQ_GEN_BINARY) +
@@ -339,11 +320,11 @@ TEST(CliVoronoi, WithoutEglAutoFallsBackToCpuAndGpuFails) {
   ScratchDir dir;
   const std::string env = "VPROXQ_EGL_LIBRARY=libvproxq-no-such-egl.so.1 ";
   const auto scene = quote(kSamples / "two-cubes" / "scene.json");
-  auto r = run_command(env + kVproxq + " " + scene + " --voronoi=auto -o " + quote(dir / "auto"));
+  auto r = run_command(env + std::string(VPROXQ_BINARY) + " " + scene + " --voronoi=auto -o " + quote(dir / "auto"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("using --voronoi=cpu"), std::string::npos) << r.output;
   EXPECT_EQ(read_json(dir / "auto" / "results.json")["settings"]["voronoi"].get<std::string>(), "cpu");
-  r = run_command(env + kVproxq + " " + scene + " --voronoi=gpu -o " + quote(dir / "gpu"));
+  r = run_command(env + std::string(VPROXQ_BINARY) + " " + scene + " --voronoi=gpu -o " + quote(dir / "gpu"));
   EXPECT_EQ(r.exit_code, 4) << r.output;
   EXPECT_NE(r.output.find("libvproxq-no-such-egl.so.1"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir / "gpu" / "results.json"));

@@ -3,7 +3,7 @@
 #include "core/query/intra_distance.hpp"
 #include "io/hdf5_reader.hpp"
 #include "io/scene_source.hpp"
-#include "support/process.hpp"
+#include "support/cli.hpp"
 #include "support/self_meshes.hpp"
 
 #include <gtest/gtest.h>
@@ -18,20 +18,9 @@ namespace fs = std::filesystem;
 using test::quote;
 using test::run_command;
 using test::ScratchDir;
+using test::read_json;
+using test::vproxq;
 
-/// Writes a frame as one OBJ with an `o` group per object, 17 significant digits.
-void write_obj_file(const Frame& frame, const fs::path& file) {
-  std::ofstream out(file);
-  out.precision(17);
-  Index base = 1;
-  for (const Object& o : frame.objects) {
-    out << "o " << o.name << "\n";
-    for (const Vec3& p : o.positions) out << "v " << p.x() << " " << p.y() << " " << p.z() << "\n";
-    for (const Face& f : o.topology->faces)
-      out << "f " << f[0] + base << " " << f[1] + base << " " << f[2] + base << "\n";
-    base += o.num_vertices();
-  }
-}
 
 TEST(CliIntra, JsonAndHdf5EqualBruteForceWithEveryBackend) {
   ScratchDir dir;
@@ -40,18 +29,17 @@ TEST(CliIntra, JsonAndHdf5EqualBruteForceWithEveryBackend) {
   made.objects.push_back(test::make_folded_sheet(rng, 12, 5, 0.1, 0.04, 0.1, "sheet"));
   made.objects.push_back(test::make_blob(rng, Vec3(2, 0, 0), 0.8, 1, 0.5, "blob"));
   made.objects.push_back(test::make_object({{5, 0, 0}, {6, 0, 0}, {5, 1, 0}}, {{0, 1, 2}}, "single"));
-  write_obj_file(made, dir / "scene.obj");
+  test::write_obj(made, dir / "scene.obj");
   // What the CLI will see: the OBJ read back (its own double parsing), not `made`.
   const Frame frame = SceneSource::open(dir / "scene.obj").load_frame(0);
   const auto ref = intra_object_distance_brute_force(frame);
   for (const char* backend : {"off", "cpu", "gpu"}) {
     SCOPED_TRACE(backend);
     const fs::path out = dir / backend;
-    const auto r = run_command(std::string(VPROXQ_BINARY) + " " + quote(dir / "scene.obj") + " -o " +
+    const auto r = test::vproxq(quote(dir / "scene.obj") + " -o " +
                                quote(out) + " --quiet --threads 2 --voronoi=" + backend);
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    std::ifstream in(out / "results.json");
-    const nlohmann::json j = nlohmann::json::parse(in);
+    const nlohmann::json j = test::read_json(out / "results.json");
     const auto& intra = j["frames"][0]["distance"]["intra"];
     ASSERT_EQ(intra.size(), ref.per_object.size());
     for (size_t i = 0; i < ref.per_object.size(); ++i) {

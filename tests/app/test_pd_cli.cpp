@@ -5,7 +5,7 @@
 #include "io/hdf5_reader.hpp"
 #include "io/mesh_reader.hpp"
 #include "io/scene_source.hpp"
-#include "support/process.hpp"
+#include "support/cli.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -70,11 +70,10 @@ TEST(PdTwoCubes, CliWritesPairsAndDepth) {
   for (const char* name : kTwoCubes) fs::copy_file(kMeshes / name, dir / name);
   const auto scene = dir.write("scene.json", R"({"name": "two-cubes", "objects": "components",
     "frames": {"files": ["two-cubes-far.ply", "two-cubes-close.ply", "two-cubes-intersecting.ply"]}})");
-  const auto r = run_command(std::string(VPROXQ_BINARY) + " " + quote(scene) +
+  const auto r = test::vproxq(quote(scene) +
                              " --queries=distance,pd --threads 2 --quiet -o " + quote(dir / "out"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  std::ifstream in(dir / "out" / "results.json");
-  const nlohmann::json j = nlohmann::json::parse(in);
+  const nlohmann::json j = test::read_json(dir / "out" / "results.json");
   EXPECT_EQ(j["queries"], nlohmann::json::array({"distance", "pd"}));
   const SceneSource source = SceneSource::open(scene);
   Hdf5Reader h5(dir / "out" / "results.h5");
@@ -129,10 +128,9 @@ TEST(PdTwoCubes, CliReportsStatusInsteadOfNumber) {
   obj += "o open\n";
   box(0.5, 9, true);
   const auto file = dir.write("boxes.obj", obj);
-  const auto r = run_command(std::string(VPROXQ_BINARY) + " " + quote(file) + " --queries=pd --quiet -o " + quote(dir / "out"));
+  const auto r = test::vproxq(quote(file) + " --queries=pd --quiet -o " + quote(dir / "out"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  std::ifstream in(dir / "out" / "results.json");
-  const nlohmann::json j = nlohmann::json::parse(in);
+  const nlohmann::json j = test::read_json(dir / "out" / "results.json");
   const auto& fj = j["frames"][0];
   EXPECT_FALSE(fj.contains("distance"));
   ASSERT_EQ(fj["pd"].size(), 1u);

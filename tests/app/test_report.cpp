@@ -1,7 +1,7 @@
 // vproxq-report (bench/report/) on a small input: real vproxq runs of two tiny sample scenes,
 // a failed run and an FCL file. The report's numbers must be the means of the inputs, missing
 // runs must show as n/a with their reason, and the CSV must hold every frame of every run.
-#include "support/process.hpp"
+#include "support/cli.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -16,13 +16,9 @@ namespace fs = std::filesystem;
 using test::quote;
 using test::run_command;
 using test::ScratchDir;
+using test::slurp;
 
 const fs::path kSamples = VPROXQ_SAMPLE_SCENES_DIR;
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
 
 std::size_t count_lines(const std::string& s) {
   return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n'));

@@ -4,7 +4,7 @@
 // with the same answers with and without Voronoi culling.
 #include "core/query/inter_distance.hpp"
 #include "io/scene_source.hpp"
-#include "support/process.hpp"
+#include "support/cli.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -21,6 +21,7 @@ namespace fs = std::filesystem;
 using test::quote;
 using test::run_command;
 using test::ScratchDir;
+using test::slurp;
 
 const fs::path kSamples = VPROXQ_SAMPLE_SCENES_DIR;
 
@@ -36,11 +37,6 @@ const TinyScene kTinyScenes[] = {
     {"funnel-tiny", "funnel --objects 12 --around 4 --along 6 --frames 4 --seed 1"},
     {"breaking-tiny", "breaking --objects 3 --cells 1 --frames 4 --seed 1"},
 };
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
 
 /// Relative paths of the regular files under `root`, sorted.
 std::set<std::string> files_under(const fs::path& root) {
