@@ -1,5 +1,7 @@
 #include "gl/voronoi_backend.hpp"
 
+#include "gl/dvd_gather_common.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -111,31 +113,6 @@ double GlVoronoiBackend::float32_error_bound(double extent) {
 
 namespace {
 
-/// Largest |coordinate| of the input: triangle corners and the grid box (sample points).
-double input_extent(const DvdInput& in) {
-  double extent = in.grid.cell *
-                  static_cast<double>(*std::max_element(in.grid.dims.begin(), in.grid.dims.end()));
-  for (const double c : in.tri_xyz_d) extent = std::max(extent, std::abs(c));
-  return extent;
-}
-
-void check_addressable(const DvdInput& in) {
-  if (in.grid.voxel_count() > std::int64_t{std::numeric_limits<std::uint32_t>::max()}) {
-    throw std::invalid_argument("GlVoronoiBackend: the grid has " +
-                                std::to_string(in.grid.voxel_count()) +
-                                " voxels; the shader addresses at most 2^32 - 1");
-  }
-  for (const std::int32_t d : in.grid.dims) {
-    if (d >= (1 << 23)) {
-      throw std::invalid_argument("GlVoronoiBackend: a grid side of " + std::to_string(d) +
-                                  " voxels is not exact in float32 (limit 2^23)");
-    }
-  }
-  if (in.tri_xyz.size() != in.tri_xyz_d.size()) {
-    throw std::invalid_argument("GlVoronoiBackend: tri_xyz and tri_xyz_d differ in size");
-  }
-}
-
 ComputeProgram compile(const Context& context, const GlVoronoiOptions& options, double& ms) {
   std::optional<ComputeProgram> program;
   ms = finish_timed_ms(context, [&] {
@@ -145,14 +122,6 @@ ComputeProgram compile(const Context& context, const GlVoronoiOptions& options, 
   return std::move(*program);
 }
 
-/// One dispatch's share of the sample voxels, with its own input and output buffers.
-struct Batch {
-  std::size_t first = 0;
-  std::size_t count = 0;
-  std::optional<StorageBuffer> samples;
-  std::optional<StorageBuffer> exclude;
-  std::optional<StorageBuffer> results;
-};
 
 }  // namespace
 
@@ -167,105 +136,54 @@ double GlVoronoiBackend::distance_error_bound(double extent) const {
 
 DvdOutput GlVoronoiBackend::compute(const DvdInput& in) {
   validate_dvd_input(in);
-  check_addressable(in);
+  check_dvd_addressable(in, "GlVoronoiBackend");
   DvdOutput out;
   last_dispatch_count_ = 0;
   const std::size_t voxel_count = in.voxels.size();
-  const std::size_t tri_count = in.tri_site.size();
   out.site1.resize(voxel_count);
   out.site2.resize(voxel_count);
   out.dist1.resize(voxel_count);
   out.dist2.resize(voxel_count);
   if (voxel_count == 0) return out;
 
-  // Batches: at most GL_MAX_COMPUTE_WORK_GROUP_COUNT[0] groups (or the option), and per-batch
-  // buffers (16 bytes per voxel for the results) within GL_MAX_SHADER_STORAGE_BLOCK_SIZE.
-  const ContextInfo& info = context_.info();
-  const std::size_t local_size = program_.local_size()[0];
-  std::size_t groups = static_cast<std::size_t>(info.max_work_group_count[0]);
-  if (options_.max_groups_per_dispatch > 0) {
-    groups = std::min<std::size_t>(groups, options_.max_groups_per_dispatch);
-  }
-  std::size_t batch_size = local_size * groups;
-  const auto block_limit = static_cast<std::size_t>(info.max_ssbo_block_size) / 16;
-  if (block_limit > 0) batch_size = std::min(batch_size, block_limit / local_size * local_size);
-  batch_size = std::max(batch_size, local_size);
-
+  // One dispatch per batch, each with its own sample, exclusion and result buffers.
+  struct Batch {
+    std::size_t first, count;
+    StorageBuffer samples, exclude, results;
+  };
   std::vector<Batch> batches;
-  for (std::size_t first = 0; first < voxel_count; first += batch_size) {
-    Batch batch;
-    batch.first = first;
-    batch.count = std::min(batch_size, voxel_count - first);
-    batches.push_back(std::move(batch));
-  }
-
-  // Upload: per-triangle info (site, first bin), samples (voxel id, band bits), the rest as is.
-  std::optional<StorageBuffer> triangles, triangle_info, bin_offsets, bin_tris;
+  std::optional<DvdSharedBuffers> shared;
   out.upload_ms = finish_timed_ms(context_, [&] {
-    std::vector<std::int32_t> tri_info(4 * tri_count);
-    for (std::size_t t = 0; t < tri_count; ++t) {
-      const double* c = &in.tri_xyz_d[9 * t];
-      const Vec3 lo(std::min({c[0], c[3], c[6]}), std::min({c[1], c[4], c[7]}),
-                    std::min({c[2], c[5], c[8]}));
-      const Vec3 hi(std::max({c[0], c[3], c[6]}), std::max({c[1], c[4], c[7]}),
-                    std::max({c[2], c[5], c[8]}));
-      const BinRange range = bins_overlapping(in, lo, hi);
-      tri_info[4 * t] = in.tri_site[t];
-      for (std::size_t a = 0; a < 3; ++a) tri_info[4 * t + 1 + a] = range.lo[a];
-    }
-    triangles.emplace(StorageBuffer::from_vector(context_, in.tri_xyz));
-    triangle_info.emplace(StorageBuffer::from_vector(context_, tri_info));
-    bin_offsets.emplace(StorageBuffer::from_vector(context_, in.bin_offsets));
-    bin_tris.emplace(StorageBuffer::from_vector(context_, in.bin_tris));
-    std::vector<std::uint32_t> samples;
+    shared.emplace(DvdSharedBuffers::upload(context_, in));
     std::vector<std::int32_t> exclude;
-    for (Batch& batch : batches) {
-      samples.resize(2 * batch.count);
-      exclude.assign(batch.count, kNoIndex);
-      for (std::size_t k = 0; k < batch.count; ++k) {
-        samples[2 * k] = static_cast<std::uint32_t>(in.voxels[batch.first + k]);
-        std::memcpy(&samples[2 * k + 1], &in.band[batch.first + k], sizeof(float));
-        if (!in.exclude_site.empty()) exclude[k] = in.exclude_site[batch.first + k];
-      }
-      batch.samples.emplace(StorageBuffer::from_vector(context_, samples));
-      batch.exclude.emplace(StorageBuffer::from_vector(context_, exclude));
-      batch.results.emplace(context_, 16 * batch.count, GL_STREAM_READ);
+    for (const auto& [first, count] : plan_batches(context_, program_, voxel_count, options_.max_groups_per_dispatch)) {
+      exclude.assign(count, kNoIndex);
+      if (!in.exclude_site.empty())
+        std::copy_n(in.exclude_site.begin() + static_cast<std::ptrdiff_t>(first), count, exclude.begin());
+      batches.push_back({first, count, StorageBuffer::from_vector(context_, pack_samples(in, first, count)),
+                         StorageBuffer::from_vector(context_, exclude),
+                         StorageBuffer(context_, 16 * count, GL_STREAM_READ)});
     }
   });
 
-  const double extent = input_extent(in);
-  program_.set_float("cell", static_cast<float>(in.grid.cell));
-  program_.set_int("dims_x", in.grid.dims[0]);
-  program_.set_int("dims_y", in.grid.dims[1]);
-  program_.set_int("dims_z", in.grid.dims[2]);
-  program_.set_int("bin_size", in.bin_size);
-  program_.set_int("bin_dims_x", in.bin_dims[0]);
-  program_.set_int("bin_dims_y", in.bin_dims[1]);
-  // Rounded up to float: the margin must not shrink.
-  program_.set_float("prefilter_margin",
-                     std::nextafter(static_cast<float>(2.0 * float32_error_bound(extent)),
-                                    std::numeric_limits<float>::infinity()));
-  triangles->bind(0);
-  triangle_info->bind(1);
-  bin_offsets->bind(2);
-  bin_tris->bind(3);
-
+  set_dvd_uniforms(program_, in, float32_error_bound(dvd_input_extent(in)));
+  shared->bind();
+  const auto local_size = static_cast<GLuint>(program_.local_size()[0]);
   out.compute_ms = finish_timed_ms(context_, [&] {
     for (const Batch& batch : batches) {
-      batch.samples->bind(4);
-      batch.results->bind(5);
-      batch.exclude->bind(8);
+      batch.samples.bind(4);
+      batch.results.bind(5);
+      batch.exclude.bind(8);
       program_.set_uint("sample_count", static_cast<GLuint>(batch.count));
-      dispatch(context_, program_, group_count(batch.count, static_cast<GLuint>(local_size)));
+      dispatch(context_, program_, group_count(batch.count, local_size));
       ++last_dispatch_count_;
     }
     memory_barrier(context_);
   });
 
   out.readback_ms = finish_timed_ms(context_, [&] {
-    std::vector<std::int32_t> results;
     for (const Batch& batch : batches) {
-      results = batch.results->download_vector<std::int32_t>(4 * batch.count);
+      const std::vector<std::int32_t> results = batch.results.download_vector<std::int32_t>(4 * batch.count);
       for (std::size_t k = 0; k < batch.count; ++k) {
         const std::size_t o = batch.first + k;
         out.site1[o] = results[4 * k];

@@ -7,7 +7,7 @@
 #include "core/geometry/point_triangle.hpp"
 #include "core/parallel.hpp"
 #include "core/timer.hpp"
-#include "core/voronoi/bins.hpp"
+#include "core/voronoi/cpu_gather.hpp"
 #include "core/voronoi/discrete_voronoi.hpp"
 
 namespace vproxq {
@@ -26,16 +26,6 @@ namespace {
 //    min(H / 2, 6 * 2^-53 * L^2 / H) <= sqrt(3 * 2^-53) * L ~ 0.31 units of D (1.07 of E);
 //  - total <= 3.47 + 1.07 + (negligible 2^-53 terms) < 4.6 units; 8 leaves a wide margin.
 constexpr double kCpuErrorBoundUnits = 8.0;
-
-// Relative slack of the bounding-box prefilter. A triangle is skipped when the distance from
-// the sample point to its bounding box exceeds the current cut-off (band, or the current 2nd
-// nearest site's distance) by more than kPrefilterSlack * (grid extent). The box distance is
-// within ~4 * 2^-53 * extent of its exact value, point_triangle_distance() is never below the
-// exact distance by more than ~10 * 2^-53 * extent (its candidates are points of the triangle
-// up to rounding), and the exact box distance never exceeds the exact triangle distance, so a
-// skipped triangle's computed distance is strictly above the cut-off: it could not have
-// entered the top two, and skipping it never changes the result.
-constexpr double kPrefilterSlack = 0x1p-30;
 
 /// No site (internal): larger than every site id, so that the tie rule "smaller site id
 /// first" needs no special case.
@@ -84,64 +74,27 @@ class CpuVoronoiBackend final : public DiscreteVoronoiBackend {
   DvdOutput compute(const DvdInput& in) override {
     validate_dvd_input(in);
     Stopwatch watch;
-    const std::size_t tri_count = in.tri_site.size();
     const std::size_t voxel_count = in.voxels.size();
 
-    // Per triangle: prepared corners, bounding box, first bin (for visiting it once).
-    std::vector<PreparedTriangle> prepared(tri_count);
-    std::vector<Vec3> box_lo(tri_count), box_hi(tri_count);
-    std::vector<std::array<std::int32_t, 3>> first_bin(tri_count);
-    parallel_for(tri_count, threads_, [&](std::size_t t) {
-      const double* c = &in.tri_xyz_d[9 * t];
-      const Triangle tri{Vec3(c[0], c[1], c[2]), Vec3(c[3], c[4], c[5]), Vec3(c[6], c[7], c[8])};
-      prepared[t] = prepare_triangle(tri);
-      box_lo[t] = tri[0].cwiseMin(tri[1]).cwiseMin(tri[2]);
-      box_hi[t] = tri[0].cwiseMax(tri[1]).cwiseMax(tri[2]);
-      first_bin[t] = bins_overlapping(in, box_lo[t], box_hi[t]).lo;
-    });
-
-    const VoronoiGrid& grid = in.grid;
-    const double slack = kPrefilterSlack * grid.cell *
-                         static_cast<double>(grid.dims[0] + grid.dims[1] + grid.dims[2]);
+    const GatherTriangles tris(in, threads_);
+    const double slack = cpu_prefilter_slack(in.grid);
     DvdOutput out;
     out.site1.resize(voxel_count);
     out.site2.resize(voxel_count);
     out.dist1.resize(voxel_count);
     out.dist2.resize(voxel_count);
     parallel_for(voxel_count, threads_, [&](std::size_t k) {
-      const std::int64_t id = in.voxels[k];
-      const std::int64_t x = id % grid.dims[0];
-      const std::int64_t y = (id / grid.dims[0]) % grid.dims[1];
-      const std::int64_t z = id / (std::int64_t{grid.dims[0]} * grid.dims[1]);
-      const Vec3 q = grid.cell * Vec3(static_cast<double>(x) + 0.5, static_cast<double>(y) + 0.5,
-                                      static_cast<double>(z) + 0.5);
+      const Vec3 q = voxel_centre(in.grid, in.voxels[k]);
       const double band = in.band[k];
       const std::int32_t skip = in.exclude_site.empty() ? kNoIndex : in.exclude_site[k];
-      const BinRange range = bins_within(in, q, band);
       TopTwo top;
-      for (std::int32_t bz = range.lo[2]; bz <= range.hi[2]; ++bz) {
-        for (std::int32_t by = range.lo[1]; by <= range.hi[1]; ++by) {
-          for (std::int32_t bx = range.lo[0]; bx <= range.hi[0]; ++bx) {
-            const auto b = static_cast<std::size_t>(bin_id(in, bx, by, bz));
-            const std::array<std::int32_t, 3> here{bx, by, bz};
-            for (std::int32_t i = in.bin_offsets[b]; i < in.bin_offsets[b + 1]; ++i) {
-              const auto t = static_cast<std::size_t>(in.bin_tris[static_cast<std::size_t>(i)]);
-              // Visit a triangle once: in the first visited bin of its own range.
-              bool first_visit = true;
-              for (std::size_t a = 0; a < 3; ++a) {
-                first_visit = first_visit && std::max(first_bin[t][a], range.lo[a]) == here[a];
-              }
-              if (!first_visit || in.tri_site[t] == skip) continue;
-              const double cutoff = std::min(band, top.d2) + slack;
-              const double box_sq =
-                  (box_lo[t] - q).cwiseMax(q - box_hi[t]).cwiseMax(0.0).squaredNorm();
-              if (box_sq > cutoff * cutoff) continue;
-              const double d = std::sqrt(point_triangle_distance(q, prepared[t]).squared_distance);
-              if (d < band) top.add(d, in.tri_site[t]);
-            }
-          }
-        }
-      }
+      tris.for_each_in(in, bins_within(in, q, band), [&](std::size_t t) {
+        if (in.tri_site[t] == skip) return;
+        const double cutoff = std::min(band, top.d2) + slack;
+        if (tris.box_distance_squared(t, q) > cutoff * cutoff) return;
+        const double d = std::sqrt(point_triangle_distance(q, tris.prepared[t]).squared_distance);
+        if (d < band) top.add(d, in.tri_site[t]);
+      });
       out.site1[k] = top.s1 == kNoSite ? kNoIndex : top.s1;
       out.site2[k] = top.s2 == kNoSite ? kNoIndex : top.s2;
       out.dist1[k] = top.s1 == kNoSite ? in.band[k] : static_cast<float>(top.d1);

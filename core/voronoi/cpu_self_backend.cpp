@@ -14,7 +14,7 @@
 #include "core/geometry/point_triangle.hpp"
 #include "core/parallel.hpp"
 #include "core/timer.hpp"
-#include "core/voronoi/bins.hpp"
+#include "core/voronoi/cpu_gather.hpp"
 #include "core/voronoi/self_stage2.hpp"
 
 namespace vproxq {
@@ -24,9 +24,6 @@ namespace {
 // backend (cpu_backend.cpp, kCpuErrorBoundUnits) applies unchanged: same double point–triangle
 // distance, same final rounding to float; the 1-ring exclusion only removes candidates.
 constexpr double kCpuSelfErrorBoundUnits = 8.0;
-// Bounding-box prefilter slack, relative to the grid extent: as in cpu_backend.cpp
-// (kPrefilterSlack), a skipped triangle's computed distance is strictly above the cut-off.
-constexpr double kPrefilterSlack = 0x1p-30;
 
 class CpuSelfVoronoiBackend final : public SelfVoronoiBackend {
  public:
@@ -42,20 +39,9 @@ class CpuSelfVoronoiBackend final : public SelfVoronoiBackend {
     validate_self_dvd_input(self);
     Stopwatch watch;
     const DvdInput& in = self.dvd;
-    const std::size_t tri_count = in.tri_site.size();
     const std::size_t sample_count = in.voxels.size();
 
-    std::vector<PreparedTriangle> prepared(tri_count);
-    std::vector<Vec3> box_lo(tri_count), box_hi(tri_count);
-    std::vector<std::array<std::int32_t, 3>> first_bin(tri_count);
-    parallel_for(tri_count, threads_, [&](std::size_t t) {
-      const double* c = &in.tri_xyz_d[9 * t];
-      const Triangle tri{Vec3(c[0], c[1], c[2]), Vec3(c[3], c[4], c[5]), Vec3(c[6], c[7], c[8])};
-      prepared[t] = prepare_triangle(tri);
-      box_lo[t] = tri[0].cwiseMin(tri[1]).cwiseMin(tri[2]);
-      box_hi[t] = tri[0].cwiseMax(tri[1]).cwiseMax(tri[2]);
-      first_bin[t] = bins_overlapping(in, box_lo[t], box_hi[t]).lo;
-    });
+    const GatherTriangles tris(in, threads_);
 
     // Runs of equal voxels: [starts[r], starts[r + 1]).
     std::vector<std::size_t> starts;
@@ -63,19 +49,12 @@ class CpuSelfVoronoiBackend final : public SelfVoronoiBackend {
       if (k == 0 || in.voxels[k] != in.voxels[k - 1]) starts.push_back(k);
     starts.push_back(sample_count);
 
-    const VoronoiGrid& grid = in.grid;
-    const double slack = kPrefilterSlack * grid.cell *
-                         static_cast<double>(grid.dims[0] + grid.dims[1] + grid.dims[2]);
+    const double slack = cpu_prefilter_slack(in.grid);
     SelfDvdOutput out;
     out.dist.resize(sample_count);
     parallel_for(starts.size() - 1, threads_, [&](std::size_t r) {
       const std::size_t first = starts[r], last = starts[r + 1];
-      const std::int64_t id = in.voxels[first];
-      const std::int64_t x = id % grid.dims[0];
-      const std::int64_t y = (id / grid.dims[0]) % grid.dims[1];
-      const std::int64_t z = id / (std::int64_t{grid.dims[0]} * grid.dims[1]);
-      const Vec3 q = grid.cell * Vec3(static_cast<double>(x) + 0.5, static_cast<double>(y) + 0.5,
-                                      static_cast<double>(z) + 0.5);
+      const Vec3 q = voxel_centre(in.grid, in.voxels[first]);
       // Per sample of this voxel: its triangle's object and vertices, band, best so far.
       struct Slot {
         std::int32_t site;
@@ -99,40 +78,26 @@ class CpuSelfVoronoiBackend final : public SelfVoronoiBackend {
         return c + slack;
       };
       double cut = cutoff();
-      const BinRange range = bins_within(in, q, max_band);
-      for (std::int32_t bz = range.lo[2]; bz <= range.hi[2]; ++bz)
-        for (std::int32_t by = range.lo[1]; by <= range.hi[1]; ++by)
-          for (std::int32_t bx = range.lo[0]; bx <= range.hi[0]; ++bx) {
-            const auto b = static_cast<std::size_t>(bin_id(in, bx, by, bz));
-            const std::array<std::int32_t, 3> here{bx, by, bz};
-            for (std::int32_t i = in.bin_offsets[b]; i < in.bin_offsets[b + 1]; ++i) {
-              const auto t = static_cast<std::size_t>(in.bin_tris[static_cast<std::size_t>(i)]);
-              // Visit a triangle once: in the first visited bin of its own range.
-              bool first_visit = true;
-              for (std::size_t a = 0; a < 3; ++a)
-                first_visit = first_visit && std::max(first_bin[t][a], range.lo[a]) == here[a];
-              if (!first_visit) continue;
-              const double box_sq = (box_lo[t] - q).cwiseMax(q - box_hi[t]).cwiseMax(0.0).squaredNorm();
-              if (box_sq > cut * cut) continue;
-              const std::int32_t site = in.tri_site[t];
-              const std::int32_t* tv = &self.tri_vertices[3 * t];
-              double d = -1;  // computed on first use
-              bool changed = false;
-              for (Slot& s : slots) {
-                if (s.site != site) continue;
-                bool adjacent = false;
-                for (int a = 0; a < 3; ++a)
-                  for (int c = 0; c < 3; ++c) adjacent = adjacent || s.v[a] == tv[c];
-                if (adjacent) continue;
-                if (d < 0) d = std::sqrt(point_triangle_distance(q, prepared[t]).squared_distance);
-                if (d < s.band && d < s.best) {
-                  s.best = d;
-                  changed = true;
-                }
-              }
-              if (changed) cut = cutoff();
-            }
+      tris.for_each_in(in, bins_within(in, q, max_band), [&](std::size_t t) {
+        if (tris.box_distance_squared(t, q) > cut * cut) return;
+        const std::int32_t site = in.tri_site[t];
+        const std::int32_t* tv = &self.tri_vertices[3 * t];
+        double d = -1;  // computed on first use
+        bool changed = false;
+        for (Slot& s : slots) {
+          if (s.site != site) continue;
+          bool adjacent = false;
+          for (int a = 0; a < 3; ++a)
+            for (int c = 0; c < 3; ++c) adjacent = adjacent || s.v[a] == tv[c];
+          if (adjacent) continue;
+          if (d < 0) d = std::sqrt(point_triangle_distance(q, tris.prepared[t]).squared_distance);
+          if (d < s.band && d < s.best) {
+            s.best = d;
+            changed = true;
           }
+        }
+        if (changed) cut = cutoff();
+      });
       for (std::size_t k = first; k < last; ++k) {
         const Slot& s = slots[k - first];
         out.dist[k] = s.best < s.band ? static_cast<float>(s.best) : in.band[k];

@@ -1,6 +1,6 @@
 #pragma once
 // Reading DvdInput back in the Voronoi backend tests (CPU and GL suites).
-#include "core/voronoi/discrete_voronoi.hpp"
+#include "core/voronoi/cpu_gather.hpp"
 
 namespace vproxq::test {
 
@@ -12,12 +12,6 @@ inline Triangle triangle_of(const DvdInput& in, std::size_t t) {
 
 /// Centre of voxel `id`, relative to the grid origin, computed as the backends do
 /// (cell * (index + 0.5); VoronoiGrid::center() adds and removes the origin, which rounds).
-inline Vec3 sample_point(const VoronoiGrid& grid, std::int64_t id) {
-  const std::int64_t x = id % grid.dims[0];
-  const std::int64_t y = (id / grid.dims[0]) % grid.dims[1];
-  const std::int64_t z = id / (std::int64_t{grid.dims[0]} * grid.dims[1]);
-  return grid.cell * Vec3(static_cast<double>(x) + 0.5, static_cast<double>(y) + 0.5,
-                          static_cast<double>(z) + 0.5);
-}
+inline Vec3 sample_point(const VoronoiGrid& grid, std::int64_t id) { return voxel_centre(grid, id); }
 
 }  // namespace vproxq::test

@@ -1,0 +1,88 @@
+#pragma once
+// Shared by the CPU Stage II backends (cpu_backend.cpp, cpu_self_backend.cpp): the triangles
+// prepared once per call, and the walk over the bins around a sample point that visits each
+// triangle once.
+#include "core/geometry/point_triangle.hpp"
+#include "core/parallel.hpp"
+#include "core/voronoi/bins.hpp"
+
+#include <array>
+#include <vector>
+
+namespace vproxq {
+
+/// Bounding-box prefilter slack of the CPU backends, relative to the grid extent. A triangle
+/// is skipped when the distance from the sample point to its bounding box exceeds the current
+/// cut-off by more than kCpuPrefilterSlack * (grid extent). The box distance is within
+/// ~4 * 2^-53 * extent of its exact value, point_triangle_distance() is never below the exact
+/// distance by more than ~10 * 2^-53 * extent (its candidates are points of the triangle up to
+/// rounding), and the exact box distance never exceeds the exact triangle distance, so a
+/// skipped triangle's computed distance is strictly above the cut-off: skipping it never
+/// changes the result.
+inline constexpr double kCpuPrefilterSlack = 0x1p-30;
+
+/// The prefilter slack for `grid` (see kCpuPrefilterSlack).
+inline double cpu_prefilter_slack(const VoronoiGrid& grid) {
+  return kCpuPrefilterSlack * grid.cell *
+         static_cast<double>(grid.dims[0] + grid.dims[1] + grid.dims[2]);
+}
+
+/// Per triangle of a DvdInput: prepared corners, bounding box, and the first bin its box
+/// overlaps (a triangle is visited in the first bin of its range that a walk reaches).
+struct GatherTriangles {
+  std::vector<PreparedTriangle> prepared;
+  std::vector<Vec3> box_lo, box_hi;
+  std::vector<std::array<std::int32_t, 3>> first_bin;
+
+  GatherTriangles(const DvdInput& in, int threads) {
+    const std::size_t n = in.tri_site.size();
+    prepared.resize(n);
+    box_lo.resize(n);
+    box_hi.resize(n);
+    first_bin.resize(n);
+    parallel_for(n, threads, [&](std::size_t t) {
+      const double* c = &in.tri_xyz_d[9 * t];
+      const Triangle tri{Vec3(c[0], c[1], c[2]), Vec3(c[3], c[4], c[5]), Vec3(c[6], c[7], c[8])};
+      prepared[t] = prepare_triangle(tri);
+      box_lo[t] = tri[0].cwiseMin(tri[1]).cwiseMin(tri[2]);
+      box_hi[t] = tri[0].cwiseMax(tri[1]).cwiseMax(tri[2]);
+      first_bin[t] = bins_overlapping(in, box_lo[t], box_hi[t]).lo;
+    });
+  }
+
+  /// Squared distance from q to triangle t's bounding box.
+  double box_distance_squared(std::size_t t, const Vec3& q) const {
+    return (box_lo[t] - q).cwiseMax(q - box_hi[t]).cwiseMax(0.0).squaredNorm();
+  }
+
+  /// Calls visit(t) once for every triangle listed in the bins of `range`.
+  template <typename Visit>
+  void for_each_in(const DvdInput& in, const BinRange& range, const Visit& visit) const {
+    for (std::int32_t bz = range.lo[2]; bz <= range.hi[2]; ++bz)
+      for (std::int32_t by = range.lo[1]; by <= range.hi[1]; ++by)
+        for (std::int32_t bx = range.lo[0]; bx <= range.hi[0]; ++bx) {
+          const auto b = static_cast<std::size_t>(bin_id(in, bx, by, bz));
+          const std::array<std::int32_t, 3> here{bx, by, bz};
+          for (std::int32_t i = in.bin_offsets[b]; i < in.bin_offsets[b + 1]; ++i) {
+            const auto t = static_cast<std::size_t>(in.bin_tris[static_cast<std::size_t>(i)]);
+            // Visit a triangle once: in the first visited bin of its own range.
+            bool first_visit = true;
+            for (std::size_t a = 0; a < 3; ++a)
+              first_visit = first_visit && std::max(first_bin[t][a], range.lo[a]) == here[a];
+            if (first_visit) visit(t);
+          }
+        }
+  }
+};
+
+/// Centre of voxel `id`, relative to the grid origin: cell * (index + 0.5), as every backend
+/// computes it.
+inline Vec3 voxel_centre(const VoronoiGrid& grid, std::int64_t id) {
+  const std::int64_t x = id % grid.dims[0];
+  const std::int64_t y = (id / grid.dims[0]) % grid.dims[1];
+  const std::int64_t z = id / (std::int64_t{grid.dims[0]} * grid.dims[1]);
+  return grid.cell * Vec3(static_cast<double>(x) + 0.5, static_cast<double>(y) + 0.5,
+                          static_cast<double>(z) + 0.5);
+}
+
+}  // namespace vproxq

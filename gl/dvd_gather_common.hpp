@@ -1,0 +1,47 @@
+#pragma once
+// What the two Stage II GL backends (voronoi_backend.cpp: dvd2_gather.comp, and
+// self_voronoi_backend.cpp: dvd_self_gather.comp appended to it) share: input checks, the
+// batching of samples into dispatches, the triangle and bin buffers (bindings 0-3), the sample
+// buffer (binding 4) and the grid uniforms.
+#include "core/voronoi/discrete_voronoi.hpp"
+#include "gl/compute.hpp"
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace vproxq::gl {
+
+/// Largest |coordinate| of the input: triangle corners and the grid box (sample points).
+double dvd_input_extent(const DvdInput& in);
+
+/// Throws std::invalid_argument (prefixed with `who`) when the shaders cannot address the
+/// grid exactly (2^32 voxels, 2^23 per side) or the float and double triangles differ in size.
+void check_dvd_addressable(const DvdInput& in, const std::string& who);
+
+/// Splits `count` samples into dispatches of at most GL_MAX_COMPUTE_WORK_GROUP_COUNT[0] groups
+/// (or `max_groups` when > 0) whose 16-byte-per-sample buffers fit
+/// GL_MAX_SHADER_STORAGE_BLOCK_SIZE: (first, count) pairs.
+std::vector<std::pair<std::size_t, std::size_t>> plan_batches(const Context& context,
+                                                              const ComputeProgram& program,
+                                                              std::size_t count,
+                                                              unsigned max_groups);
+
+/// Bindings 0-3 of dvd2_gather.comp: triangles (float), per-triangle info (site and first
+/// bin), bin offsets, bin triangles.
+struct DvdSharedBuffers {
+  StorageBuffer triangles, triangle_info, bin_offsets, bin_tris;
+
+  static DvdSharedBuffers upload(const Context& context, const DvdInput& in);
+  void bind() const;
+};
+
+/// Binding 4 of a batch: per sample, the linear voxel id and the float bits of its band.
+std::vector<std::uint32_t> pack_samples(const DvdInput& in, std::size_t first, std::size_t count);
+
+/// The grid and bin uniforms, and the prefilter margin: twice `error_bound`, rounded up to
+/// float (the margin must not shrink; see dvd2_gather.comp).
+void set_dvd_uniforms(ComputeProgram& program, const DvdInput& in, double error_bound);
+
+}  // namespace vproxq::gl
