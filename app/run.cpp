@@ -136,14 +136,16 @@ VoronoiStage make_voronoi_stage(const Config& config, int threads) {
   return stage;
 }
 
-VoronoiFrameStats frame_stats(const SelfVoronoiBounds& b) {
+/// The stats of either Stage II (VoronoiBounds or SelfVoronoiBounds) for the output.
+template <typename Bounds>
+VoronoiFrameStats frame_stats(const Bounds& b, std::uint64_t samples) {
   VoronoiFrameStats v;
   v.grid_dims = b.grid.dims;
   v.cell = b.grid.cell;
   v.delta = b.delta;
   v.delta_precision = b.delta_precision;
   v.sample_voxels = b.sample_voxels;
-  v.samples = b.samples;
+  v.samples = samples;
   v.setup_ms = b.setup_ms;
   v.upload_ms = b.upload_ms;
   v.compute_ms = b.compute_ms;
@@ -168,7 +170,7 @@ void run_intra(const Frame& frame, const FrameBoxes& boxes, VoronoiStage& vorono
   if (voronoi.self_backend) {
     bounds = compute_self_voronoi_bounds(frame, boxes, ring2, *voronoi.self_backend, grid, threads);
     opts.voronoi = &bounds;
-    result.self_voronoi = frame_stats(bounds);
+    result.self_voronoi = frame_stats(bounds, bounds.samples);
   }
   result.time_ms.intra_voronoi = sw.elapsed_ms();
   result.time_ms.voronoi += result.time_ms.intra_voronoi;
@@ -250,18 +252,7 @@ void run(const Config& config) {
         bounds = compute_voronoi_bounds(frame, boxes, stage1, *voronoi.backend, grid, info.threads);
         result.time_ms.voronoi = sw.elapsed_ms();
         opts.voronoi = &bounds;
-        VoronoiFrameStats v;
-        v.grid_dims = bounds.grid.dims;
-        v.cell = bounds.grid.cell;
-        v.delta = bounds.delta;
-        v.delta_precision = bounds.delta_precision;
-        v.sample_voxels = bounds.sample_voxels;
-        v.setup_ms = bounds.setup_ms;
-        v.upload_ms = bounds.upload_ms;
-        v.compute_ms = bounds.compute_ms;
-        v.readback_ms = bounds.readback_ms;
-        v.scan_ms = bounds.scan_ms;
-        result.voronoi = v;
+        result.voronoi = frame_stats(bounds, bounds.sample_voxels);
       }
       if (want_distance) {
         InterDistanceOutput d = inter_object_distance(frame, boxes, stage1, opts);

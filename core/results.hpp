@@ -73,7 +73,7 @@ struct VoronoiFrameStats {
   double delta = 0;            ///< Lemma 2's δ = cell diagonal / 2 + slack + δ_precision
   double delta_precision = 0;  ///< the backend's arithmetic error bound
   std::uint64_t sample_voxels = 0;
-  std::uint64_t samples = 0;  ///< self Stage II: (voxel, triangle) samples (0 for inter-object)
+  std::uint64_t samples = 0;  ///< samples evaluated: (voxel, triangle) pairs for the self Stage II, = sample_voxels for the inter-object one
   double setup_ms = 0, upload_ms = 0, compute_ms = 0, readback_ms = 0, scan_ms = 0;
 };
 
