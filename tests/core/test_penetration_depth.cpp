@@ -1,6 +1,8 @@
 // Local penetration depth (paper 3.3) against analytic truth: overlapping axis-aligned boxes
 // (depth d along the overlap axis), overlapping icospheres (depth within the stated sampling
-// error of r1 + r2 - |c1 - c2|), the exact inside test, and the statuses where PD is undefined.
+// error of r1 + r2 - |c1 - c2|), the exact inside test, and the statuses where PD is undefined;
+// self-intersecting objects against analytic depths and against the same geometry as
+// separate objects (the inter-object twin).
 #include "core/query/intersecting_pairs.hpp"
 #include "core/geometry/point_triangle.hpp"
 #include "core/mesh/adjacency.hpp"
