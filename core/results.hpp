@@ -105,7 +105,8 @@ enum class PdStatus : std::uint8_t {
   TooDeep = 4,        ///< the overlap holds a whole connected part of an object: no local answer
   Shallow = 5,        ///< no vertex lies strictly inside the other object and no overlapping
                       ///< triangle has a normal (all degenerate): no direction to measure along
-  SelfIntersection = 6,  ///< a self-intersecting object: not computed in this version
+  SelfIntersection = 6,  ///< a self-intersection whose sheets the method cannot tell apart
+                         ///< (README): no number
 };
 
 /// Stable text of a PdStatus (JSON "status", README).

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <iterator>
 #include <tuple>
 
 namespace vproxq {
@@ -68,6 +69,214 @@ int winding_number(const Vec3& p, const Object& o, const TriangleBvh& bvh, bool&
   });
   return on_surface ? 0 : w;
 }
+
+// ---------------------------------------------------------------------------------------
+// Self-intersections: the winding number on a vertex's outward side.
+//
+// A vertex v of a closed, consistently oriented object O lies on O's own surface, so O's
+// winding number w is not defined at v. Near v (closer than any face that does not contain
+// v) the surface is v's star only, which splits a small ball around v into two sides: the
+// outward side (the faces' normals point into it) with winding w_out, and the inward side
+// with w_out + 1 (crossing a face against its normal enters one more time). w_out is what we
+// need: it is the winding number of "the rest of O" at v, i.e. of the other sheets.
+//
+// It is computed exactly with the +x ray of winding_number(), cast from a symbolic point
+//     q = v + eps (n1 - v) + eps^2 (n2 - v) + (0, e, e^2),   eps >> eps^2 >> e >> e^2 > 0,
+// where f = (v, n1, n2) is a non-degenerate face of the star written from v in its own
+// cyclic order: v + eps (n1 - v) + eps^2 (n2 - v) lies inside f next to v (barycentric
+// 1 - eps - eps^2, eps, eps^2), and (0, e, e^2) is the ray perturbation used everywhere
+// else. Every predicate is affine in its last point, so its sign at q is the first nonzero
+// of: its value at v, at n1 (the eps term once the value at v is 0), at n2, then the e and
+// e^2 terms of the ray perturbation - all exact orientation predicates on mesh points.
+// Summing the signed crossings of every face except f gives the winding number just past f
+// on the side that +x (or, for a face parallel to x, the perturbation) points to; that side
+// is the outward one iff the first nonzero component of f's normal is positive. So
+//     w_out = sum            if that component is positive,
+//     w_out = sum - 1        otherwise.
+// Only faces whose box meets the ray from v can be crossed (the faces near q contain v).
+//
+// A vertex is "inside another sheet" when w_out differs from its value at a vertex where
+// the surface is single: for an outward-oriented closed surface that value is 0 (and w is
+// 2 in a doubly covered region, -1 where a sheet folds inwards through another), for an
+// inward-oriented one -1. The reference is taken per connected component of the mesh at
+// its lexicographically largest vertex (largest x, then y, then z): every point of the
+// component has x <= that vertex's x, so the ray from it leaves into the unbounded region
+// (w = 0) and one of its two sides has w = 0: w_out there is 0 (outward) or -1 (inward).
+// The reference counts only the component's own faces (another component may enclose the
+// vertex). For two separate objects merged into one, w_out - reference is then exactly the
+// other object's winding number, i.e. the inter-object inside test: the twin the tests
+// check. (A vertex inside two other components of opposite orientations would cancel out;
+// objects are not expected to nest like that.)
+// ---------------------------------------------------------------------------------------
+
+/// An object and the BVH of its triangles.
+struct ObjectView {
+  const Object* object;
+  const TriangleBvh* bvh;
+};
+
+/// The symbolic point q above, from v inside the star face (v, n1, n2).
+struct StarPoint {
+  Vec3 v, n1, n2;
+};
+
+/// Sign of orient2d_projected(u, w, q, 0) at the symbolic q (see above).
+int orient_yz_star(const Vec3& u, const Vec3& w, const StarPoint& q) {
+  for (const Vec3* p : {&q.v, &q.n1, &q.n2}) {
+    const int o = orient2d_projected(u, w, *p, 0);
+    if (o != 0) return o;
+  }
+  return orient_yz_perturbed(u, w, q.v);  // its value at v is 0: the perturbation decides
+}
+
+/// Sign of orient3d(t, q) at the symbolic q: the n . (q - t0) of ray_crossing().
+int above_star(const Triangle& t, const StarPoint& q) {
+  for (const Vec3* p : {&q.v, &q.n1, &q.n2}) {
+    const int o = orient3d(t[0], t[1], t[2], *p);
+    if (o != 0) return o;
+  }
+  // The perturbation (0, e, e^2) adds e n.y + e^2 n.z.
+  const int ny = orient2d_projected(t[0], t[1], t[2], 1);
+  return ny != 0 ? ny : orient2d_projected(t[0], t[1], t[2], 2);
+}
+
+/// ray_crossing() from the symbolic q; sets coplanar when q lies on t (t covers the star
+/// face f next to v: overlapping coplanar faces, undecidable).
+int ray_crossing_star(const StarPoint& q, const Triangle& t, bool& coplanar) {
+  const int s = orient2d_projected(t[0], t[1], t[2], 0);
+  if (s == 0) return 0;
+  for (int k = 0; k < 3; ++k)
+    if (orient_yz_star(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)], q) != s) return 0;
+  const int above = above_star(t, q);
+  if (above == 0) {
+    coplanar = true;
+    return 0;
+  }
+  return above == -s ? s : 0;
+}
+
+enum class VertexSide : std::uint8_t {
+  Decided,       ///< w_out computed
+  OnOtherSheet,  ///< v lies on a face that does not contain it (another sheet passes through v)
+  Undecided,     ///< every face of the star is degenerate, or another face covers it coplanarly
+};
+
+/// w_out of vertex v of `o` (see above), counting only the faces t with keep(t).
+template <typename Keep>
+VertexSide outward_winding(const ObjectView& view, Index v, const Keep& keep, int& w_out) {
+  const Object& o = *view.object;
+  const Vec3& p = o.positions[static_cast<size_t>(v)];
+  auto has_v = [&](Index t) {
+    const Face& f = o.topology->faces[static_cast<size_t>(t)];
+    return f[0] == v || f[1] == v || f[2] == v;
+  };
+  // Another sheet through v: w_out is then not a property of v's neighbourhood. Such a
+  // vertex lies on the intersection curve; like a vertex on the other object's surface in
+  // the inter-object walk, it counts as not inside.
+  bool on = false;
+  AABB point;
+  point.lo = point.hi = p;
+  view.bvh->query(point, [] { return 0.0; }, [&](Index t, double) {
+    if (!on && !has_v(t) && keep(t)) on = segment_triangle_intersection(p, p, o.triangle(t)).intersecting;
+  });
+  if (on) return VertexSide::OnOtherSheet;
+  const Adjacency& adj = adjacency(*o.topology);
+  Index face = kNoIndex;
+  for (Index t : adj.vertex_triangles(v))
+    if (!triangle_is_degenerate(o.triangle(t))) {
+      face = t;
+      break;
+    }
+  if (face == kNoIndex) return VertexSide::Undecided;
+  const Face& f = o.topology->faces[static_cast<size_t>(face)];
+  const int k = f[0] == v ? 0 : f[1] == v ? 1 : 2;
+  const StarPoint q{p, o.positions[static_cast<size_t>(f[static_cast<size_t>((k + 1) % 3)])],
+                    o.positions[static_cast<size_t>(f[static_cast<size_t>((k + 2) % 3)])]};
+  AABB ray;
+  ray.lo = p;
+  ray.hi = Vec3(kInfinity, p.y(), p.z());
+  int sum = 0;
+  bool coplanar = false;
+  view.bvh->query(ray, [] { return 0.0; }, [&](Index t, double) {
+    if (t != face && !coplanar && keep(t)) sum += ray_crossing_star(q, o.triangle(t), coplanar);
+  });
+  if (coplanar) return VertexSide::Undecided;
+  const Triangle tf = o.triangle(face);
+  int side = 0;
+  for (int axis = 0; axis < 3 && side == 0; ++axis) side = orient2d_projected(tf[0], tf[1], tf[2], axis);
+  w_out = side > 0 ? sum : sum - 1;
+  return VertexSide::Decided;
+}
+
+/// Disjoint sets over 0..n-1 (path halving; the smaller root wins, so roots are canonical).
+struct DisjointSets {
+  std::vector<Index> parent;
+  explicit DisjointSets(size_t n) : parent(n) {
+    for (size_t k = 0; k < n; ++k) parent[k] = static_cast<Index>(k);
+  }
+  Index find(Index a) {
+    while (parent[static_cast<size_t>(a)] != a) {
+      parent[static_cast<size_t>(a)] = parent[static_cast<size_t>(parent[static_cast<size_t>(a)])];
+      a = parent[static_cast<size_t>(a)];
+    }
+    return a;
+  }
+  void unite(Index a, Index b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
+  }
+};
+
+/// What a self-intersecting object needs across its contacts: the w_out of a single-sheet
+/// vertex of each connected component of the mesh, computed when first needed.
+struct SelfContext {
+  const ObjectView* view = nullptr;
+  std::vector<Index> component;  ///< per vertex: the component's root
+  std::vector<Index> top;        ///< per root: the lexicographically largest vertex
+  std::vector<int> reference;    ///< per root: its w_out; kUnset, or kUndecided
+  static constexpr int kUnset = 1 << 30, kUndecided = kUnset + 1;
+
+  explicit SelfContext(const ObjectView& v) : view(&v) {
+    const Object& o = *v.object;
+    const size_t n = static_cast<size_t>(o.num_vertices());
+    DisjointSets sets(n);
+    for (const Face& f : o.topology->faces) {
+      sets.unite(f[0], f[1]);
+      sets.unite(f[0], f[2]);
+    }
+    component.resize(n);
+    top.assign(n, kNoIndex);
+    reference.assign(n, kUnset);
+    auto larger = [&](Index a, Index b) {  // lexicographic on (x, y, z), then the id
+      const Vec3& pa = o.positions[static_cast<size_t>(a)];
+      const Vec3& pb = o.positions[static_cast<size_t>(b)];
+      return std::tie(pa.x(), pa.y(), pa.z(), a) > std::tie(pb.x(), pb.y(), pb.z(), b);
+    };
+    for (size_t k = 0; k < n; ++k) {
+      const Index r = sets.find(static_cast<Index>(k));
+      component[k] = r;
+      Index& t = top[static_cast<size_t>(r)];
+      if (t == kNoIndex || larger(static_cast<Index>(k), t)) t = static_cast<Index>(k);
+    }
+  }
+
+  /// w_out of a single-sheet vertex of v's component (0 or -1), or kUndecided.
+  int reference_of(Index v) {
+    const Index r = component[static_cast<size_t>(v)];
+    int& ref = reference[static_cast<size_t>(r)];
+    if (ref == kUnset) {
+      int w = 0;
+      const Object& o = *view->object;
+      auto own = [&](Index t) {
+        return component[static_cast<size_t>(o.topology->faces[static_cast<size_t>(t)][0])] == r;
+      };
+      const VertexSide s = outward_winding(*view, top[static_cast<size_t>(r)], own, w);
+      ref = (s == VertexSide::Decided && (w == 0 || w == -1)) ? w : kUndecided;
+    }
+    return ref;
+  }
+};
 
 // ---------------------------------------------------------------------------------------
 // Surface checks: the interior is defined when every edge is used by exactly two faces, once
@@ -171,29 +380,20 @@ void intersection_vertices(const Triangle& f, const Triangle& g, std::vector<Vec
 // The local walk.
 // ---------------------------------------------------------------------------------------
 
-struct ObjectView {
-  const Object* object;
-  const TriangleBvh* bvh;
-};
-
 struct Walk {
-  std::vector<Index> inside;  ///< ascending
+  std::vector<Index> inside;                    ///< ascending
+  std::vector<std::vector<Index>> components;   ///< the vertices of each flood, ascending
   bool swallowed = false;     ///< some connected set of inside vertices has no outside neighbour
 };
 
-/// Vertices of `a` inside `b`, connected to the seeds through inside vertices.
-Walk walk_inside(const ObjectView& a, const ObjectView& b, const std::vector<Index>& seed_triangles) {
-  const Object& oa = *a.object;
+/// Vertices of `oa` for which inside(v) holds, connected to the vertices of the seed
+/// triangles through such vertices; inside() is called at most once per vertex.
+template <typename Inside>
+Walk walk_from(const Object& oa, const std::vector<Index>& seed_triangles, const Inside& inside) {
   const Adjacency& adj = adjacency(*oa.topology);
   enum : std::int8_t { kUnknown = 0, kInside = 1, kOutside = 2 };
   std::vector<std::int8_t> state(static_cast<size_t>(oa.num_vertices()), kUnknown);
-  auto classify = [&](Index v) {
-    bool on = false;
-    const int w = winding_number(oa.positions[static_cast<size_t>(v)], *b.object, *b.bvh, on);
-    // On the other surface counts as outside: such a vertex is a vertex of an intersection
-    // segment, which the depth takes into account anyway.
-    state[static_cast<size_t>(v)] = (!on && w != 0) ? kInside : kOutside;
-  };
+  auto classify = [&](Index v) { state[static_cast<size_t>(v)] = inside(v) ? kInside : kOutside; };
   Walk walk;
   std::deque<Index> queue;
   std::vector<Index> seeds;
@@ -209,12 +409,13 @@ Walk walk_inside(const ObjectView& a, const ObjectView& b, const std::vector<Ind
   for (Index s : seeds) {
     if (state[static_cast<size_t>(s)] != kInside || expanded[static_cast<size_t>(s)]) continue;
     bool meets_outside = false;
+    std::vector<Index> component;
     queue.push_back(s);
     expanded[static_cast<size_t>(s)] = 1;
     while (!queue.empty()) {
       const Index v = queue.front();
       queue.pop_front();
-      walk.inside.push_back(v);
+      component.push_back(v);
       for (Index t : adj.vertex_triangles(v))
         for (Index u : oa.topology->faces[static_cast<size_t>(t)]) {
           if (state[static_cast<size_t>(u)] == kUnknown) classify(u);
@@ -227,20 +428,37 @@ Walk walk_inside(const ObjectView& a, const ObjectView& b, const std::vector<Ind
         }
     }
     if (!meets_outside) walk.swallowed = true;
+    std::sort(component.begin(), component.end());
+    walk.inside.insert(walk.inside.end(), component.begin(), component.end());
+    walk.components.push_back(std::move(component));
   }
   std::sort(walk.inside.begin(), walk.inside.end());
   return walk;
 }
 
-/// Nearest point of `o`'s surface to p (ties: the smallest triangle id).
-std::pair<double, Vec3> nearest_point(const Vec3& p, const ObjectView& o) {
+/// Vertices of `a` inside `b`, connected to the seeds through inside vertices.
+Walk walk_inside(const ObjectView& a, const ObjectView& b, const std::vector<Index>& seed_triangles) {
+  const Object& oa = *a.object;
+  return walk_from(oa, seed_triangles, [&](Index v) {
+    bool on = false;
+    const int w = winding_number(oa.positions[static_cast<size_t>(v)], *b.object, *b.bvh, on);
+    // On the other surface counts as outside: such a vertex is a vertex of an intersection
+    // segment, which the depth takes into account anyway.
+    return !on && w != 0;
+  });
+}
+
+/// Nearest point of `o`'s surface to p (ties: the smallest triangle id), leaving out the
+/// triangles t with skip(t); distance +inf when every triangle is left out.
+template <typename Skip>
+std::pair<double, Vec3> nearest_point(const Vec3& p, const ObjectView& o, const Skip& skip) {
   double best_sq = kInfinity;
   Index best_t = kNoIndex;
   Vec3 best_q = p;
   AABB box;
   box.lo = box.hi = p;
   o.bvh->query(box, [&] { return std::sqrt(best_sq); }, [&](Index t, double d2) {
-    if (d2 > best_sq) return;
+    if (d2 > best_sq || skip(t)) return;
     const PointTriangleResult r = point_triangle_distance(p, o.object->triangle(t));
     if (r.squared_distance < best_sq || (r.squared_distance == best_sq && t < best_t)) {
       best_sq = r.squared_distance;
@@ -249,6 +467,10 @@ std::pair<double, Vec3> nearest_point(const Vec3& p, const ObjectView& o) {
     }
   });
   return {std::sqrt(best_sq), best_q};
+}
+
+std::pair<double, Vec3> nearest_point(const Vec3& p, const ObjectView& o) {
+  return nearest_point(p, o, [](Index) { return false; });
 }
 
 /// max - min of the projections of the points on the unit vector u.
@@ -273,6 +495,261 @@ std::vector<Index> overlapping_triangles(const Object& o, const std::vector<Inde
   return out;
 }
 
+// ---------------------------------------------------------------------------------------
+// Self-intersections: the local walk within one object.
+//
+// A contact is a connected set of intersecting pairs of the object: pairs are linked when
+// they share a triangle or their triangles share a vertex. Per contact:
+//  - the walk (as between objects) starts at the vertices of the contact's triangles and
+//    floods through vertices inside another sheet (w_out != reference, see above); each flood
+//    is one connected set of inside vertices C, i.e. one piece of sheet pushed into another
+//    sheet, bounded by the intersection curve. A flood without an outside neighbour: too_deep.
+//  - the vertex's own sheet near the contact, R(C): the triangles touching C, and from those
+//    that intersect nothing a flood across edges through triangles that intersect nothing.
+//    The triangles the curve runs through are included where the flood meets them, but not
+//    crossed: the curve bounds R(C). If R(C) holds both triangles of an intersecting pair,
+//    the curve does not separate the two sheets there (e.g. a triangle-sized fold): the
+//    contact is undecided (status self_intersection).
+//  - T: for each v in C, its nearest point on the object outside R(C), i.e. on the sheet(s)
+//    across the curve; the pair of maximal distance gives T, the translation of the deepest
+//    vertex's sheet that brings it out. Leaving in triangles of the vertex's own side
+//    beyond the curve is harmless when they lie outside the other sheet: the segment from v
+//    (inside it) to such a point crosses the other sheet first, at a nearer point.
+//  - depth: the width along T of all inside vertices of the contact and of the vertices of
+//    its intersection segments, as between objects.
+// For two objects merged into one (with or without a bridge elsewhere) this is the
+// inter-object computation: the inside vertices are the same, R(C) is the vertex's own
+// object's part inside the other, and the nearest point lies on the other object.
+// ---------------------------------------------------------------------------------------
+
+/// PD of one self-intersection contact of the object of `view` (pairs [first, last) of it).
+PenetrationDepth self_contact_depth(SelfContext& ctx, Index object, const std::vector<IntersectingPair>& pairs,
+                                    std::vector<int>& stamp, int& next_stamp) {
+  const ObjectView& view = *ctx.view;
+  const Object& o = *view.object;
+  const Adjacency& adj = adjacency(*o.topology);
+  PenetrationDepth pd;
+  pd.objects = {object, object};
+  std::vector<Index> hit;  // the contact's intersecting triangles
+  for (const IntersectingPair& p : pairs) {
+    hit.push_back(p.tri_a);
+    hit.push_back(p.tri_b);
+  }
+  std::sort(hit.begin(), hit.end());
+  hit.erase(std::unique(hit.begin(), hit.end()), hit.end());
+  auto is_hit = [&](Index t) { return std::binary_search(hit.begin(), hit.end(), t); };
+  pd.overlapping_triangles = {hit, {}};
+
+  bool undecided = false;
+  const Walk walk = walk_from(o, hit, [&](Index v) {
+    const int ref = ctx.reference_of(v);
+    int w = 0;
+    const VertexSide s = outward_winding(view, v, [](Index) { return true; }, w);
+    if (ref == SelfContext::kUndecided || s == VertexSide::Undecided) {
+      undecided = true;
+      return false;
+    }
+    return s == VertexSide::Decided && w != ref;
+  });
+  if (undecided) {
+    pd.status = PdStatus::SelfIntersection;
+    return pd;
+  }
+  if (walk.swallowed) {
+    pd.inside_vertices = {walk.inside, {}};
+    pd.status = PdStatus::TooDeep;
+    return pd;
+  }
+
+  // Own sheet R(C) of each inside component, nearest points outside it.
+  double best = -1;
+  size_t deepest_component = 0;
+  std::vector<std::vector<Index>> touching(walk.components.size());  // triangles touching C
+  std::vector<std::vector<Index>> region_hits(walk.components.size());
+  for (size_t c = 0; c < walk.components.size(); ++c) {
+    const int mark = next_stamp++;
+    auto in_region = [&](Index t) { return stamp[static_cast<size_t>(t)] == mark; };
+    std::vector<Index> stack;
+    auto add = [&](Index t) {
+      if (in_region(t)) return;
+      stamp[static_cast<size_t>(t)] = mark;
+      if (is_hit(t)) region_hits[c].push_back(t);
+      else stack.push_back(t);
+    };
+    for (Index v : walk.components[c])
+      for (Index t : adj.vertex_triangles(v)) {
+        touching[c].push_back(t);
+        add(t);
+      }
+    while (!stack.empty()) {
+      const Index t = stack.back();
+      stack.pop_back();
+      for (Index e : adj.triangle_edges(t)) {
+        if (e == kNoIndex) continue;
+        for (Index u : adj.edge_triangles(e)) add(u);
+      }
+    }
+    for (const IntersectingPair& p : pairs)
+      if (in_region(p.tri_a) && in_region(p.tri_b)) undecided = true;
+    if (undecided) break;
+    std::sort(touching[c].begin(), touching[c].end());
+    touching[c].erase(std::unique(touching[c].begin(), touching[c].end()), touching[c].end());
+    std::sort(region_hits[c].begin(), region_hits[c].end());
+    for (Index v : walk.components[c]) {
+      const Vec3& p = o.positions[static_cast<size_t>(v)];
+      const auto [d, q] = nearest_point(p, view, in_region);
+      if (d == kInfinity) {  // the own sheet is the whole object
+        undecided = true;
+        break;
+      }
+      if (d > best) {
+        best = d;
+        deepest_component = c;
+        pd.deepest_object = object;
+        pd.deepest_vertex = v;
+        pd.deepest_point = p;
+        pd.nearest_point = q;
+        pd.direction = q - p;
+      }
+    }
+    if (undecided) break;
+  }
+  if (undecided) {
+    pd.deepest_object = pd.deepest_vertex = kNoIndex;
+    pd.deepest_point = pd.nearest_point = pd.direction = Vec3::Zero();
+    pd.inside_vertices = {walk.inside, {}};
+    pd.status = PdStatus::SelfIntersection;
+    return pd;
+  }
+
+  // Features: side 0 is the deepest vertex's piece of sheet (its inside vertices, the
+  // triangles touching them and the intersecting triangles bounding it), side 1 the rest.
+  std::array<std::vector<Index>, 2> verts, tris;
+  for (size_t c = 0; c < walk.components.size(); ++c) {
+    const size_t side = c == deepest_component ? 0 : 1;
+    verts[side].insert(verts[side].end(), walk.components[c].begin(), walk.components[c].end());
+    if (side == 0) {
+      std::set_union(touching[c].begin(), touching[c].end(), region_hits[c].begin(), region_hits[c].end(),
+                     std::back_inserter(tris[0]));
+    } else {
+      tris[1].insert(tris[1].end(), touching[c].begin(), touching[c].end());
+    }
+  }
+  if (walk.components.empty()) {  // nothing inside: split the pairs' triangles by position
+    for (const IntersectingPair& p : pairs) {
+      tris[0].push_back(p.tri_a);
+      tris[1].push_back(p.tri_b);
+    }
+  } else {
+    tris[1].insert(tris[1].end(), hit.begin(), hit.end());
+  }
+  for (int side = 0; side < 2; ++side) {
+    auto& t = tris[static_cast<size_t>(side)];
+    std::sort(t.begin(), t.end());
+    t.erase(std::unique(t.begin(), t.end()), t.end());
+    std::sort(verts[static_cast<size_t>(side)].begin(), verts[static_cast<size_t>(side)].end());
+  }
+  std::vector<Index> rest;
+  std::set_difference(tris[1].begin(), tris[1].end(), tris[0].begin(), tris[0].end(), std::back_inserter(rest));
+  tris[1] = std::move(rest);
+  pd.inside_vertices = verts;
+  pd.overlapping_triangles = tris;
+
+  std::vector<Vec3> points;
+  for (const IntersectingPair& p : pairs) intersection_vertices(o.triangle(p.tri_a), o.triangle(p.tri_b), points);
+  for (Index v : walk.inside) points.push_back(o.positions[static_cast<size_t>(v)]);
+  if (best > 0) {
+    pd.direction /= pd.direction.norm();
+    pd.depth = width(points, pd.direction);
+    pd.status = PdStatus::Ok;
+    return pd;
+  }
+  // No vertex strictly inside another sheet: as between objects, the overlapping face
+  // normal along which the overlap is narrowest; T = -n translates that face's sheet back
+  // (the other sheet lies on its outward side).
+  pd.deepest_object = pd.deepest_vertex = kNoIndex;
+  pd.deepest_point = pd.nearest_point = Vec3::Zero();
+  double narrowest = kInfinity;
+  for (int side = 0; side < 2; ++side)
+    for (Index t : tris[static_cast<size_t>(side)]) {
+      const Triangle tri = o.triangle(t);
+      Vec3 n = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
+      const double len = n.norm();
+      if (!(len > 0)) continue;
+      n /= len;
+      const double w = width(points, n);
+      if (w < narrowest) {
+        narrowest = w;
+        pd.direction = -n;
+      }
+    }
+  if (narrowest == kInfinity) {
+    pd.status = PdStatus::Shallow;
+    pd.direction = Vec3::Zero();
+    return pd;
+  }
+  pd.depth = narrowest;
+  pd.status = PdStatus::Ok;
+  return pd;
+}
+
+/// The entry of a self-intersecting object: its contacts (see above), reported as the first
+/// contact that is too_deep or undecided if any (no number may hide a deeper or unknown
+/// overlap), else the contact of greatest depth.
+PenetrationDepth self_depth(const ObjectView& view, PdStatus surface,
+                            std::vector<IntersectingPair>::const_iterator first,
+                            std::vector<IntersectingPair>::const_iterator last) {
+  const Object& o = *view.object;
+  const Index object = first->object_a;
+  if (surface != PdStatus::Ok) {
+    PenetrationDepth pd;
+    pd.objects = {object, object};
+    for (auto it = first; it != last; ++it) {
+      pd.overlapping_triangles[0].push_back(it->tri_a);
+      pd.overlapping_triangles[0].push_back(it->tri_b);
+    }
+    auto& all = pd.overlapping_triangles[0];
+    std::sort(all.begin(), all.end());
+    all.erase(std::unique(all.begin(), all.end()), all.end());
+    pd.status = surface;
+    return pd;
+  }
+  // Contacts: pairs linked through shared triangles or triangles sharing a vertex.
+  const size_t n = static_cast<size_t>(o.num_triangles());
+  std::vector<char> hit(n, 0);
+  for (auto it = first; it != last; ++it) hit[static_cast<size_t>(it->tri_a)] = hit[static_cast<size_t>(it->tri_b)] = 1;
+  DisjointSets sets(n);
+  const Adjacency& adj = adjacency(*o.topology);
+  for (auto it = first; it != last; ++it) {
+    sets.unite(it->tri_a, it->tri_b);
+    for (Index t : {it->tri_a, it->tri_b})
+      for (Index u : adj.ring1(t))
+        if (hit[static_cast<size_t>(u)]) sets.unite(t, u);
+  }
+  std::vector<std::pair<Index, size_t>> keyed;  // (contact root, position), in pair order
+  for (auto it = first; it != last; ++it) keyed.emplace_back(sets.find(it->tri_a), static_cast<size_t>(it - first));
+  std::stable_sort(keyed.begin(), keyed.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  SelfContext ctx(view);
+  std::vector<int> stamp(n, -1);
+  int next_stamp = 0;
+  PenetrationDepth chosen;
+  bool have = false;
+  for (size_t k = 0; k < keyed.size();) {
+    std::vector<IntersectingPair> contact;
+    size_t e = k;
+    for (; e < keyed.size() && keyed[e].first == keyed[k].first; ++e) contact.push_back(*(first + static_cast<std::ptrdiff_t>(keyed[e].second)));
+    k = e;
+    PenetrationDepth pd = self_contact_depth(ctx, object, contact, stamp, next_stamp);
+    if (pd.status == PdStatus::TooDeep || pd.status == PdStatus::SelfIntersection) return pd;
+    if (!have || (pd.status == PdStatus::Ok && (chosen.status != PdStatus::Ok || pd.depth > chosen.depth))) {
+      chosen = std::move(pd);
+      have = true;
+    }
+  }
+  return chosen;
+}
+
 /// PD of one object pair, given its intersecting triangle pairs [first, last).
 PenetrationDepth pair_depth(const std::vector<ObjectView>& views,
                             const std::vector<PdStatus>& surface,
@@ -290,17 +767,7 @@ PenetrationDepth pair_depth(const std::vector<ObjectView>& views,
     std::sort(h.begin(), h.end());
     h.erase(std::unique(h.begin(), h.end()), h.end());
   }
-  if (ia == ib) {
-    // Both sheets belong to one object: which side of the other sheet is "inside" needs a
-    // winding number relative to that sheet alone; not computed in this version.
-    std::vector<Index> all = hit[0];
-    all.insert(all.end(), hit[1].begin(), hit[1].end());
-    std::sort(all.begin(), all.end());
-    all.erase(std::unique(all.begin(), all.end()), all.end());
-    pd.status = PdStatus::SelfIntersection;
-    pd.overlapping_triangles = {all, all};
-    return pd;
-  }
+  if (ia == ib) return self_depth(views[static_cast<size_t>(ia)], surface[static_cast<size_t>(ia)], first, last);
   const ObjectView& va = views[static_cast<size_t>(ia)];
   const ObjectView& vb = views[static_cast<size_t>(ib)];
   pd.overlapping_triangles = hit;
@@ -412,10 +879,8 @@ PenetrationDepthOutput penetration_depth(const Frame& frame, const FrameBoxes& b
            intersecting[e].object_b == intersecting[k].object_b)
       ++e;
     runs.emplace_back(k, e);
-    if (intersecting[k].object_a != intersecting[k].object_b) {
-      involved[static_cast<size_t>(intersecting[k].object_a)] = 1;
-      involved[static_cast<size_t>(intersecting[k].object_b)] = 1;
-    }
+    involved[static_cast<size_t>(intersecting[k].object_a)] = 1;
+    involved[static_cast<size_t>(intersecting[k].object_b)] = 1;
     k = e;
   }
   std::vector<TriangleBvh> bvhs(n);

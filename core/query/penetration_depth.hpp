@@ -42,7 +42,13 @@ struct PenetrationDepthOutput {
 ///  4. Depth: max - min of the projections on T of the inside vertices of both objects and of
 ///     the vertices of the intersection segments/polygons of the intersecting triangle pairs
 ///     (together, the vertices of the overlap region's boundary near the contact).
-/// Self-intersections (pairs of one object) get status self_intersection.
+/// Self-intersections (pairs of one object, entry objects = [i, i]): the same steps within
+/// the object, per contact (connected set of its intersecting pairs). "Inside" is the exact
+/// winding number of the object's own surface on the vertex's outward side (a symbolic point
+/// inside one of its faces, next to it) differing from its single-sheet value; T's nearest
+/// point is taken outside the vertex's own sheet, bounded by the intersection curve; the
+/// entry is the deepest contact. Status self_intersection only where that cannot be decided
+/// (penetration_depth.cpp, "Self-intersections", and README).
 PenetrationDepthOutput penetration_depth(const Frame& frame, const FrameBoxes& boxes,
                                          const std::vector<IntersectingPair>& intersecting,
                                          const PenetrationDepthOptions& opts);

@@ -1,6 +1,8 @@
 // Local penetration depth (paper 3.3) against analytic truth: overlapping axis-aligned boxes
 // (depth d along the overlap axis), overlapping icospheres (depth within the stated sampling
-// error of r1 + r2 - |c1 - c2|), the exact inside test, and the statuses where PD is undefined.
+// error of r1 + r2 - |c1 - c2|), the exact inside test, and the statuses where PD is undefined;
+// self-intersecting objects against analytic depths and against the same geometry as
+// separate objects (the inter-object twin).
 #include "core/query/intersecting_pairs.hpp"
 #include "core/geometry/point_triangle.hpp"
 #include "core/mesh/adjacency.hpp"
@@ -391,23 +393,6 @@ TEST(PenetrationDepth, UndefinedCasesGetAStatus) {
     EXPECT_EQ(pd[0].status, PdStatus::TooDeep) << pd_status_name(pd[0].status);
     EXPECT_EQ(pd[0].inside_vertices[1].size(), 8u);
   }
-  {  // A self-intersecting object: a documented status, no number
-    const Object merged = [&] {
-      Object m = make_box(Vec3::Zero(), Vec3::Ones(), 1, "m");
-      const Object other = make_box(Vec3(0.5, 0.2, 0.3), Vec3::Ones(), 1, "o");
-      auto topo = std::make_shared<Topology>(*m.topology);
-      const Index base = static_cast<Index>(m.positions.size());
-      for (const Vec3& p : other.positions) m.positions.push_back(p);
-      for (const Face& f : other.topology->faces) topo->faces.push_back({f[0] + base, f[1] + base, f[2] + base});
-      topo->num_vertices = static_cast<Index>(m.positions.size());
-      m.topology = topo;
-      return m;
-    }();
-    const auto pd = run_pd(frame_of({merged}));
-    ASSERT_EQ(pd.size(), 1u);
-    EXPECT_EQ(pd[0].objects, (std::array<Index, 2>{0, 0}));
-    EXPECT_EQ(pd[0].status, PdStatus::SelfIntersection);
-  }
 }
 
 TEST(PenetrationDepth, InsideVerticesAreTheWalkClosureOfBruteForceWinding) {
@@ -458,6 +443,299 @@ TEST(PenetrationDepth, InsideVerticesAreTheWalkClosureOfBruteForceWinding) {
   std::printf("[ blobs ] %zu pd entries ok, %zu inside vertices checked\n", ok, checked);
   EXPECT_GT(checked, 50u);
   EXPECT_GT(ok, 3u);
+}
+
+// ---------------------------------------------------------------------------------------
+// Self-intersections: one closed, consistently oriented object whose sheets overlap.
+// ---------------------------------------------------------------------------------------
+
+/// A box built like make_box with counts[k] cells along axis k; the cell (i, j) of the face
+/// (axis, side) listed in `hole` is left open, and its four corners (in the face's cyclic
+/// order) are returned in `hole_ring`.
+struct HoledBox {
+  Object object;
+  std::array<Index, 4> hole_ring{kNoIndex, kNoIndex, kNoIndex, kNoIndex};
+};
+HoledBox make_grid_box(const Vec3& lo, const Vec3& size, std::array<int, 3> counts,
+                       std::array<int, 4> hole = {-1, -1, -1, -1}) {
+  std::map<std::array<int, 3>, Index> ids;
+  HoledBox out;
+  Object& o = out.object;
+  auto topo = std::make_shared<Topology>();
+  auto vertex = [&](std::array<int, 3> g) {
+    auto it = ids.find(g);
+    if (it != ids.end()) return it->second;
+    const Index id = static_cast<Index>(o.positions.size());
+    Vec3 p;
+    for (int k = 0; k < 3; ++k)
+      p[k] = lo[k] + size[k] * (static_cast<double>(g[static_cast<size_t>(k)]) / counts[static_cast<size_t>(k)]);
+    o.positions.push_back(p);
+    ids[g] = id;
+    return id;
+  };
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      for (int i = 0; i < counts[static_cast<size_t>(u)]; ++i)
+        for (int j = 0; j < counts[static_cast<size_t>(v)]; ++j) {
+          auto corner = [&](int di, int dj) {
+            std::array<int, 3> g{};
+            g[static_cast<size_t>(axis)] = side * counts[static_cast<size_t>(axis)];
+            g[static_cast<size_t>(u)] = i + di;
+            g[static_cast<size_t>(v)] = j + dj;
+            return vertex(g);
+          };
+          const Index a = corner(0, 0), b = corner(1, 0), c = corner(1, 1), d = corner(0, 1);
+          if (hole == std::array<int, 4>{axis, side, i, j}) {
+            out.hole_ring = {a, b, c, d};
+            continue;
+          }
+          if (side == 1) {
+            topo->faces.push_back({a, b, c});
+            topo->faces.push_back({a, c, d});
+          } else {
+            topo->faces.push_back({a, c, b});
+            topo->faces.push_back({a, d, c});
+          }
+        }
+    }
+  topo->num_vertices = static_cast<Index>(o.positions.size());
+  o.topology = topo;
+  o.name = "box";
+  return out;
+}
+
+/// The objects as one object (vertex ids of objects[k] shifted by the earlier vertex counts).
+Object merge(const std::vector<Object>& parts, const std::string& name) {
+  Object m;
+  auto topo = std::make_shared<Topology>();
+  for (const Object& p : parts) {
+    const Index base = static_cast<Index>(m.positions.size());
+    m.positions.insert(m.positions.end(), p.positions.begin(), p.positions.end());
+    for (const Face& f : p.topology->faces) topo->faces.push_back({f[0] + base, f[1] + base, f[2] + base});
+  }
+  topo->num_vertices = static_cast<Index>(m.positions.size());
+  m.topology = topo;
+  m.name = name;
+  return m;
+}
+
+Object flip_all(const Object& o) {
+  Object f = o;
+  auto topo = std::make_shared<Topology>(*o.topology);
+  for (Face& face : topo->faces) std::swap(face[1], face[2]);
+  f.topology = topo;
+  return f;
+}
+
+/// Every directed edge used once and its reverse once: closed and consistently oriented.
+bool closed_and_oriented(const Object& o) {
+  std::map<std::pair<Index, Index>, int> used;
+  for (const Face& f : o.topology->faces)
+    for (int k = 0; k < 3; ++k) ++used[{f[static_cast<size_t>(k)], f[static_cast<size_t>((k + 1) % 3)]}];
+  for (const auto& [e, n] : used) {
+    if (n != 1) return false;
+    const auto r = used.find({e.second, e.first});
+    if (r == used.end() || r->second != 1) return false;
+  }
+  return true;
+}
+
+/// Box A = [0,1]^3 and box B = [1-d, 2-d] x [0.25, 0.85] x [0.15, 0.95] (cells of 0.1, no
+/// grid line of one on a face plane of the other): they overlap in the slab [1-d, 1] along
+/// x, whose thinnest extent is d (d < 0.3). `bridged` joins them into ONE closed surface: a
+/// square tube (a U with mitred corners) from a bottom cell of A (x in [0.2, 0.3]) down to
+/// z = -0.6, across below both boxes and up into a bottom cell of B (x in [1.6-d, 1.7-d],
+/// beyond A), touching nothing else.
+struct BoxPair {
+  Object a, b;   // the plain boxes
+  Object bridged;
+  double depth;  // exact: A's max x minus B's min x, as stored
+};
+BoxPair make_box_pair(double d) {
+  BoxPair out;
+  const Vec3 blo(1 - d, 0.25, 0.15), bsize(1, 0.6, 0.8);
+  out.a = make_grid_box(Vec3::Zero(), Vec3::Ones(), {10, 10, 10}).object;
+  out.b = make_grid_box(blo, bsize, {10, 6, 8}).object;
+  const HoledBox ha = make_grid_box(Vec3::Zero(), Vec3::Ones(), {10, 10, 10}, {2, 0, 2, 4});
+  const HoledBox hb = make_grid_box(blo, bsize, {10, 6, 8}, {2, 0, 6, 2});
+  Object m = merge({ha.object, hb.object}, "bridged");
+  auto topo = std::make_shared<Topology>(*m.topology);
+  const Index base_b = ha.object.num_vertices();
+  // Rings of the tube, corner k of each matching corner k of A's hole (offset (dx, dy) from
+  // the hole's centre): A's hole; the mitred ring of the turn from -z to +x at K1 (corner
+  // K1 + dx (x + z) + dy y); that of the turn from +x to +z at K2 (K2 + dx (z - x) + dy y);
+  // B's hole, where the U-turn has mirrored the offsets: corner k is B's corner at (-dx, dy).
+  std::array<std::array<Index, 4>, 4> rings;
+  rings[0] = ha.hole_ring;
+  const std::array<Index, 4> mirrored{hb.hole_ring[1], hb.hole_ring[0], hb.hole_ring[3], hb.hole_ring[2]};
+  for (int k = 0; k < 4; ++k) rings[3][static_cast<size_t>(k)] = mirrored[static_cast<size_t>(k)] + base_b;
+  const Vec3 centre_a(0.25, 0.45, 0), k1(0.25, 0.45, -0.6), k2(1.65 - d, 0.5, -0.6);
+  for (int r : {1, 2})
+    for (int k = 0; k < 4; ++k) {
+      const Vec3 off = m.positions[static_cast<size_t>(rings[0][static_cast<size_t>(k)])] - centre_a;
+      const Vec3 p = r == 1 ? Vec3(k1 + Vec3(off.x(), off.y(), off.x())) : Vec3(k2 + Vec3(-off.x(), off.y(), off.x()));
+      rings[static_cast<size_t>(r)][static_cast<size_t>(k)] = static_cast<Index>(m.positions.size());
+      m.positions.push_back(p);
+    }
+  std::vector<Face> tube;
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 4; ++k) {
+      const Index a = rings[static_cast<size_t>(r)][static_cast<size_t>(k)];
+      const Index b = rings[static_cast<size_t>(r)][static_cast<size_t>((k + 1) % 4)];
+      const Index c = rings[static_cast<size_t>(r + 1)][static_cast<size_t>((k + 1) % 4)];
+      const Index e = rings[static_cast<size_t>(r + 1)][static_cast<size_t>(k)];
+      tube.push_back({a, b, c});
+      tube.push_back({a, c, e});
+    }
+  topo->num_vertices = static_cast<Index>(m.positions.size());
+  const size_t boxes_faces = topo->faces.size();
+  topo->faces.insert(topo->faces.end(), tube.begin(), tube.end());
+  m.topology = topo;
+  if (!closed_and_oriented(m)) {  // the tube's winding was the other way round
+    for (size_t f = boxes_faces; f < topo->faces.size(); ++f) std::swap(topo->faces[f][1], topo->faces[f][2]);
+  }
+  out.bridged = m;
+  double amax = -kInfinity, bmin = kInfinity;
+  for (const Vec3& p : out.a.positions) amax = std::max(amax, p.x());
+  for (const Vec3& p : out.b.positions) bmin = std::min(bmin, p.x());
+  out.depth = amax - bmin;
+  return out;
+}
+
+TEST(PenetrationDepthSelf, BridgedBoxesGiveDepthDAndMatchTheTwin) {
+  for (double d : {0.05, 0.15, 0.25}) {
+    SCOPED_TRACE("d " + std::to_string(d));
+    const BoxPair bp = make_box_pair(d);
+    ASSERT_TRUE(closed_and_oriented(bp.bridged));
+    const Index na = bp.a.num_vertices();
+    // The one object: its sheets intersect (intra pairs only) and are connected by the tube.
+    const Frame self_frame = frame_of({bp.bridged});
+    const FrameBoxes boxes = FrameBoxes::compute(self_frame, 2);
+    const auto pairs = intersecting_pairs(self_frame, boxes, {2, nullptr, true}).pairs;
+    ASSERT_FALSE(pairs.empty());
+    for (const IntersectingPair& p : pairs) {  // only box-against-box pairs: the tube is clear
+      const Face& fa = bp.bridged.topology->faces[static_cast<size_t>(p.tri_a)];
+      const Face& fb = bp.bridged.topology->faces[static_cast<size_t>(p.tri_b)];
+      EXPECT_TRUE((fa[0] < na) != (fb[0] < na)) << p.tri_a << " " << p.tri_b;
+    }
+    const auto self = penetration_depth(self_frame, boxes, pairs, {2}).pairs;
+    ASSERT_EQ(self.size(), 1u);
+    EXPECT_EQ(self[0].objects, (std::array<Index, 2>{0, 0}));
+    ASSERT_EQ(self[0].status, PdStatus::Ok) << pd_status_name(self[0].status);
+    EXPECT_LE(std::abs(self[0].depth - bp.depth), 1e-9 * bp.depth) << "depth " << self[0].depth;
+    EXPECT_LE(std::abs(std::abs(self[0].direction.x()) - 1), 1e-12) << self[0].direction.transpose();
+    EXPECT_NE(self[0].deepest_vertex, kNoIndex);
+    // The twin: the same boxes as two objects, through the inter-object path.
+    const auto twin = run_pd(frame_of({bp.a, bp.b}));
+    ASSERT_EQ(twin.size(), 1u);
+    ASSERT_EQ(twin[0].status, PdStatus::Ok);
+    EXPECT_LE(std::abs(twin[0].depth - bp.depth), 1e-9 * bp.depth);
+    EXPECT_LE(std::abs(self[0].depth - twin[0].depth), 1e-9 * bp.depth);
+    EXPECT_LE(std::abs(std::abs(self[0].direction.dot(twin[0].direction)) - 1), 1e-12);
+    // Same overlapping features: the vertices of A inside B and of B inside A (B's ids are
+    // shifted by A's vertex count in the merged object; the holes removed faces only).
+    std::vector<Index> twin_inside = twin[0].inside_vertices[0];
+    for (Index v : twin[0].inside_vertices[1]) twin_inside.push_back(v + na);
+    std::vector<Index> self_inside = self[0].inside_vertices[0];
+    self_inside.insert(self_inside.end(), self[0].inside_vertices[1].begin(), self[0].inside_vertices[1].end());
+    std::sort(twin_inside.begin(), twin_inside.end());
+    std::sort(self_inside.begin(), self_inside.end());
+    EXPECT_EQ(self_inside, twin_inside);
+    EXPECT_GT(self_inside.size(), 10u);
+    std::printf("[ self bridged ] d %.2f exact %.17g self %.17g twin %.17g, %zu pairs, %zu inside vertices\n", d,
+                bp.depth, self[0].depth, twin[0].depth, pairs.size(), self_inside.size());
+
+    // The same surface with every face flipped (inward-oriented), and the two boxes as one
+    // object of two components without the tube: the same depth.
+    for (const Object& variant : {flip_all(bp.bridged), merge({bp.a, bp.b}, "merged"), flip_all(merge({bp.a, bp.b}, "m"))}) {
+      const auto pd = run_pd(frame_of({variant}));
+      ASSERT_EQ(pd.size(), 1u);
+      ASSERT_EQ(pd[0].status, PdStatus::Ok) << pd_status_name(pd[0].status);
+      EXPECT_LE(std::abs(pd[0].depth - bp.depth), 1e-9 * bp.depth) << "depth " << pd[0].depth;
+      EXPECT_LE(std::abs(std::abs(pd[0].direction.x()) - 1), 1e-12);
+    }
+  }
+}
+
+TEST(PenetrationDepthSelf, DentPushedThroughTheBottomIsAnInwardFold) {
+  // The box [0,3]^3 with the centre of its top face pushed down to (1.5, 1.5, -d): the dent
+  // goes through the bottom face, enclosing a region of winding number -1 below it, d thick.
+  // Its tip is the deepest vertex, nearest to the bottom face straight above it: T = +z
+  // (the dent's sheet moves up), depth d. The same with the faces flipped.
+  for (double d : {0.2, 0.7}) {
+    Object dented = make_box(Vec3::Zero(), Vec3::Constant(3), 2, "dented");
+    Index tip = kNoIndex;
+    for (Index v = 0; v < dented.num_vertices(); ++v)
+      if (dented.positions[static_cast<size_t>(v)] == Vec3(1.5, 1.5, 3)) {
+        dented.positions[static_cast<size_t>(v)] = Vec3(1.5, 1.5, -d);
+        tip = v;
+      }
+    ASSERT_NE(tip, kNoIndex);
+    for (const Object& o : {dented, flip_all(dented)}) {
+      SCOPED_TRACE("d " + std::to_string(d));
+      const auto pd = run_pd(frame_of({o}));
+      ASSERT_EQ(pd.size(), 1u);
+      ASSERT_EQ(pd[0].status, PdStatus::Ok) << pd_status_name(pd[0].status);
+      EXPECT_LE(std::abs(pd[0].depth - d), 1e-9 * d) << "depth " << pd[0].depth;
+      EXPECT_LE((pd[0].direction - Vec3(0, 0, 1)).norm(), 1e-12) << pd[0].direction.transpose();
+      EXPECT_EQ(pd[0].deepest_vertex, tip);
+      EXPECT_EQ(pd[0].inside_vertices[0], std::vector<Index>{tip});
+      ASSERT_EQ(pd[0].inside_vertices[1].size(), 1u);  // the bottom's centre, in the dent
+      EXPECT_EQ(o.positions[static_cast<size_t>(pd[0].inside_vertices[1][0])], Vec3(1.5, 1.5, 0));
+    }
+  }
+}
+
+TEST(PenetrationDepthSelf, CoarseMergedBoxesMatchTheTwin) {
+  // 12-triangle boxes offset along all axes, as one object of two components: every
+  // triangle near the contact intersects, each side has a single inside corner. The self
+  // path must reproduce the inter-object answer (no simple closed form here: the deepest
+  // corner is nearest to a side face, so this is the paper's local estimate).
+  for (const Vec3& offset : {Vec3(0.5, 0.2, 0.3), Vec3(-0.3, 0.6, -0.45), Vec3(0.7, -0.1, 0.25)}) {
+    const Object a = make_box(Vec3::Zero(), Vec3::Ones(), 1, "a");
+    const Object b = make_box(offset, Vec3::Ones(), 1, "b");
+    const auto twin = run_pd(frame_of({a, b}));
+    const auto self = run_pd(frame_of({merge({a, b}, "ab")}));
+    ASSERT_EQ(twin.size(), 1u);
+    ASSERT_EQ(self.size(), 1u);
+    ASSERT_EQ(twin[0].status, PdStatus::Ok);
+    ASSERT_EQ(self[0].status, PdStatus::Ok) << pd_status_name(self[0].status);
+    EXPECT_GT(self[0].depth, 0.0);
+    EXPECT_LE(std::abs(self[0].depth - twin[0].depth), 1e-12) << self[0].depth << " vs " << twin[0].depth;
+    EXPECT_LE(std::abs(std::abs(self[0].direction.dot(twin[0].direction)) - 1), 1e-12);
+  }
+}
+
+TEST(PenetrationDepthSelf, UndefinedCasesGetAStatus) {
+  const BoxPair bp = make_box_pair(0.15);
+  {  // one face of A removed: open
+    Object open = bp.bridged;
+    auto topo = std::make_shared<Topology>(*open.topology);
+    topo->faces.erase(topo->faces.begin());
+    open.topology = topo;
+    const auto pd = run_pd(frame_of({open}));
+    ASSERT_EQ(pd.size(), 1u);
+    EXPECT_EQ(pd[0].status, PdStatus::OpenSurface);
+  }
+  {  // one face flipped: not consistently oriented
+    Object flipped = bp.bridged;
+    auto topo = std::make_shared<Topology>(*flipped.topology);
+    std::swap(topo->faces[5][1], topo->faces[5][2]);
+    flipped.topology = topo;
+    const auto pd = run_pd(frame_of({flipped}));
+    ASSERT_EQ(pd.size(), 1u);
+    EXPECT_EQ(pd[0].status, PdStatus::NonOrientable);
+  }
+  {  // a small box swallowed by a dented big one, both one object: too_deep
+    Object big = make_box(Vec3::Zero(), Vec3::Constant(3), 2, "big");
+    for (Vec3& p : big.positions)
+      if (p == Vec3(1.5, 1.5, 3)) p = Vec3(1.5, 1.5, 1);
+    const Object small = make_box(Vec3(1, 1, 0.5), Vec3::Ones(), 1, "small");
+    const auto pd = run_pd(frame_of({merge({big, small}, "nested")}));
+    ASSERT_EQ(pd.size(), 1u);
+    EXPECT_EQ(pd[0].status, PdStatus::TooDeep) << pd_status_name(pd[0].status);
+  }
 }
 
 TEST(PenetrationDepth, NoIntersectionNoEntry) {
