@@ -145,6 +145,8 @@ void main() {
   uint id = samples[i].x;
   float band = uintBitsToFloat(samples[i].y);
   int skip = exclude_sites[i];
+  // With an excluded site only the nearest other site is asked for (DvdOutput).
+  bool nearest_only = skip != kNoIndex;
   uint dx = uint(dims_x);
   uint dy = uint(dims_y);
   ivec3 voxel = ivec3(int(id % dx), int((id / dx) % dy), int(id / (dx * dy)));
@@ -187,7 +189,7 @@ void main() {
           }
           float d = point_triangle_distance_squared(q, a, b3, c);
           int s = info.x;
-          float previous_d2 = d2;
+          float previous_limit = nearest_only ? d1 : d2;
           if (s == s1) {
             d1 = min(d1, d);
           } else if (before(d, s, d1, s1)) {
@@ -201,8 +203,9 @@ void main() {
             d2 = d;
             s2 = s;
           }
-          if (d2 != previous_d2) {
-            cutoff = min(band, sqrt(d2)) + prefilter_margin;
+          float limit = nearest_only ? d1 : d2;
+          if (limit != previous_limit) {
+            cutoff = min(band, sqrt(limit)) + prefilter_margin;
             cutoff_squared = cutoff * cutoff;
           }
         }
@@ -212,7 +215,7 @@ void main() {
   float dist1 = sqrt(d1);
   float dist2 = sqrt(d2);
   bool has1 = s1 != kNoSite && dist1 < band;
-  bool has2 = s2 != kNoSite && dist2 < band;
+  bool has2 = !nearest_only && s2 != kNoSite && dist2 < band;
   results[i] = ivec4(has1 ? s1 : kNoIndex, has2 ? s2 : kNoIndex,
                      floatBitsToInt(has1 ? dist1 : band), floatBitsToInt(has2 ? dist2 : band));
 }

@@ -1,6 +1,8 @@
 // The CPU twin of the Stage II backend: the 2nd-order discrete Voronoi diagram at the sample
 // voxels, in double precision, multi-threaded over voxels.
 #include <algorithm>
+#include <atomic>
+#include <stdexcept>
 #include <cmath>
 #include <limits>
 
@@ -77,6 +79,12 @@ class CpuVoronoiBackend final : public DiscreteVoronoiBackend {
     const std::size_t voxel_count = in.voxels.size();
 
     const GatherTriangles tris(in, threads_);
+    // Stamps for the walk's "seen" marks: unique over all calls (thread_local arrays outlive
+    // a call on the calling thread), voxel index in the low 32 bits.
+    static std::atomic<std::uint64_t> calls{0};
+    const std::uint64_t call = (++calls) << 32;
+    if (voxel_count >= (std::uint64_t{1} << 32))
+      throw std::invalid_argument("CpuVoronoiBackend: more than 2^32 - 1 sample voxels");
     const double slack = cpu_prefilter_slack(in.grid);
     DvdOutput out;
     out.site1.resize(voxel_count);
@@ -87,18 +95,23 @@ class CpuVoronoiBackend final : public DiscreteVoronoiBackend {
       const Vec3 q = voxel_centre(in.grid, in.voxels[k]);
       const double band = in.band[k];
       const std::int32_t skip = in.exclude_site.empty() ? kNoIndex : in.exclude_site[k];
+      // With an excluded site only the nearest other site is asked for (DvdOutput).
+      const bool nearest_only = skip != kNoIndex;
       TopTwo top;
-      tris.for_each_in(in, bins_within(in, q, band), [&](std::size_t t) {
+      auto cutoff = [&] { return std::min(band, nearest_only ? top.d1 : top.d2) + slack; };
+      thread_local std::vector<std::uint64_t> seen;
+      for_each_nearest_first(in, q, bins_within(in, q, band), seen, call | k, cutoff, [&](std::size_t t) {
         if (in.tri_site[t] == skip) return;
-        const double cutoff = std::min(band, top.d2) + slack;
-        if (tris.box_distance_squared(t, q) > cutoff * cutoff) return;
+        const double c = cutoff();
+        if (tris.box_distance_squared(t, q) > c * c) return;
         const double d = std::sqrt(point_triangle_distance(q, tris.prepared[t]).squared_distance);
         if (d < band) top.add(d, in.tri_site[t]);
       });
+      const bool has2 = !nearest_only && top.s2 != kNoSite;
       out.site1[k] = top.s1 == kNoSite ? kNoIndex : top.s1;
-      out.site2[k] = top.s2 == kNoSite ? kNoIndex : top.s2;
+      out.site2[k] = has2 ? top.s2 : kNoIndex;
       out.dist1[k] = top.s1 == kNoSite ? in.band[k] : static_cast<float>(top.d1);
-      out.dist2[k] = top.s2 == kNoSite ? in.band[k] : static_cast<float>(top.d2);
+      out.dist2[k] = has2 ? static_cast<float>(top.d2) : in.band[k];
     });
     out.compute_ms = watch.elapsed_ms();
     return out;

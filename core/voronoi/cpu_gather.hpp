@@ -6,7 +6,9 @@
 #include "core/parallel.hpp"
 #include "core/voronoi/bins.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cstdlib>
 #include <vector>
 
 namespace vproxq {
@@ -74,6 +76,53 @@ struct GatherTriangles {
         }
   }
 };
+
+/// Calls visit(t) for the triangles listed in the bins of `range`, bins in rings of increasing
+/// Chebyshev distance around the bin of q, each triangle at most once per `stamp` (`seen` holds
+/// the last stamp per triangle; it grows as needed; a stamp must never repeat). Stops before a
+/// ring all of whose points are farther from q than cutoff() (+ the relative slack below), so
+/// every triangle having a point within cutoff() of q is visited, whatever cutoff() returns
+/// while the walk goes on (it may only shrink).
+template <typename Cutoff, typename Visit>
+void for_each_nearest_first(const DvdInput& in, const Vec3& q,
+                            const BinRange& range, std::vector<std::uint64_t>& seen,
+                            std::uint64_t stamp, const Cutoff& cutoff, const Visit& visit) {
+  if (seen.size() < in.tri_site.size()) seen.resize(in.tri_site.size(), 0);
+  std::array<std::int32_t, 3> c{};
+  std::int32_t rings = 0;
+  for (int a = 0; a < 3; ++a) {
+    const auto k = static_cast<std::size_t>(a);
+    c[k] = std::clamp(bin_coordinate(in, a, q[a]), range.lo[k], range.hi[k]);
+    rings = std::max({rings, c[k] - range.lo[k], range.hi[k] - c[k]});
+  }
+  // A bin r rings away is separated from q's bin by r - 1 whole bins along some axis.
+  const double width = in.grid.cell * in.bin_size;
+  auto visit_bin = [&](std::int32_t bx, std::int32_t by, std::int32_t bz) {
+    const auto b = static_cast<std::size_t>(bin_id(in, bx, by, bz));
+    for (std::int32_t i = in.bin_offsets[b]; i < in.bin_offsets[b + 1]; ++i) {
+      const auto t = static_cast<std::size_t>(in.bin_tris[static_cast<std::size_t>(i)]);
+      if (seen[t] == stamp) continue;
+      seen[t] = stamp;
+      visit(t);
+    }
+  };
+  for (std::int32_t r = 0; r <= rings; ++r) {
+    if (r >= 2 && (r - 1) * width > cutoff() * (1 + 0x1p-20)) break;
+    const std::int32_t z0 = std::max(range.lo[2], c[2] - r), z1 = std::min(range.hi[2], c[2] + r);
+    const std::int32_t y0 = std::max(range.lo[1], c[1] - r), y1 = std::min(range.hi[1], c[1] + r);
+    const std::int32_t x0 = std::max(range.lo[0], c[0] - r), x1 = std::min(range.hi[0], c[0] + r);
+    for (std::int32_t bz = z0; bz <= z1; ++bz)
+      for (std::int32_t by = y0; by <= y1; ++by) {
+        const bool shell = std::abs(bz - c[2]) == r || std::abs(by - c[1]) == r;
+        if (shell) {
+          for (std::int32_t bx = x0; bx <= x1; ++bx) visit_bin(bx, by, bz);
+        } else {
+          if (c[0] - r >= range.lo[0]) visit_bin(c[0] - r, by, bz);
+          if (r > 0 && c[0] + r <= range.hi[0]) visit_bin(c[0] + r, by, bz);
+        }
+      }
+  }
+}
 
 /// Centre of voxel `id`, relative to the grid origin: cell * (index + 0.5), as every backend
 /// computes it.

@@ -56,7 +56,8 @@ struct DvdInput {
 };
 
 /// What a backend returns: per sample voxel (same order as DvdInput::voxels), among the sites
-/// other than its exclude_site, the nearest site and the nearest site different from it, with distances (kNoIndex / band when none
+/// other than its exclude_site, the nearest site and the nearest site different from it (only
+/// the nearest where exclude_site is set: then site2 is kNoIndex and dist2 the band), with distances (kNoIndex / band when none
 /// within the band). Ties between sites go to the smaller site id.
 struct DvdOutput {
   std::vector<std::int32_t> site1, site2;
