@@ -8,8 +8,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -409,11 +407,6 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
     });
   }
   timings_.cooccupancy_ms = sw.elapsed_ms();
-  if (std::getenv("VPROXQ_CCD_PROFILE"))
-    std::fprintf(stderr, "ccd stage2: dims %d %d %d slots %d marks %zu room %llu setup %.1f vox %.1f compact %.1f cooc %.1f ms\n",
-                 grid_.dims[0], grid_.dims[1], grid_.dims[2], slots_, keys_.size(),
-                 static_cast<unsigned long long>(in.out_offsets.back()), timings_.setup_ms,
-                 timings_.voxelize_ms, timings_.compact_ms, timings_.cooccupancy_ms);
 }
 
 bool CcdVoxelCulling::share_voxel(Index i, Index f, Index j, Index g) const {
