@@ -12,6 +12,7 @@
 #include "core/voronoi/ccd_stage2.hpp"
 #include "core/voronoi/stage2.hpp"
 #include "gl/egl_context.hpp"
+#include "gl/ccd_voxel_backend.hpp"
 #include "gl/self_voronoi_backend.hpp"
 #include "gl/voronoi_backend.hpp"
 #include "io/output.hpp"
@@ -106,6 +107,7 @@ struct VoronoiStage {
   std::optional<gl::Context> context;
   std::unique_ptr<DiscreteVoronoiBackend> backend;
   std::unique_ptr<SelfVoronoiBackend> self_backend;  ///< the same kind, for the intra query
+  std::unique_ptr<CcdVoxelBackend> ccd_backend;       ///< the same kind, for CCD's Stage II
 };
 
 VoronoiStage make_voronoi_stage(const Config& config, int threads) {
@@ -129,9 +131,11 @@ VoronoiStage make_voronoi_stage(const Config& config, int threads) {
   if (stage.context) {
     stage.backend = std::make_unique<gl::GlVoronoiBackend>(*stage.context);
     stage.self_backend = std::make_unique<gl::GlSelfVoronoiBackend>(*stage.context);
+    stage.ccd_backend = std::make_unique<gl::GlCcdVoxelBackend>(*stage.context);
   } else {
     stage.backend = make_cpu_voronoi_backend(threads);
     stage.self_backend = make_cpu_self_voronoi_backend(threads);
+    stage.ccd_backend = make_cpu_ccd_voxel_backend(threads);
   }
   return stage;
 }
@@ -271,7 +275,7 @@ void run(const Config& config) {
       result.time_ms.exact += sw.elapsed_ms();
     }
     if (next_frame) {
-      // Stage II for CCD runs the same host code for cpu and gpu in this version (README).
+      // Stage II for CCD: records on the host, voxels and co-occupancy on the backend.
       sw.restart();
       const CcdSweep sweep = CcdSweep::compute(frame, *next_frame, info.threads);
       const double sweep_ms = sw.elapsed_ms();
@@ -279,7 +283,7 @@ void run(const Config& config) {
       double voxel_ms = 0;
       if (voronoi.backend) {
         sw.restart();
-        voxels.emplace(frame, *next_frame, sweep, grid, info.threads);
+        voxels.emplace(frame, *next_frame, sweep, CcdVoxelOptions{grid, 0, info.threads}, *voronoi.ccd_backend);
         voxel_ms = sw.elapsed_ms();
       }
       CcdStepResult c = continuous_collisions(frame, *next_frame, sweep,

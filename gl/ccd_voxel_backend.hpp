@@ -1,0 +1,39 @@
+#pragma once
+// CCD Stage II on the GPU: the CcdVoxelBackend of core/voronoi/ccd_stage2.hpp as an OpenGL 4.3
+// compute shader (shaders/ccd_voxels.comp), one invocation per (triangle, time slot) record.
+// Pass 0 lists each record's voxels and marks the dense co-occupancy table with atomics; pass
+// 1 flags the records with a key of two objects. Integer work only: the output equals the CPU
+// backend's bit for bit (tests/gl/test_ccd_voxels_gl.cpp).
+#include "core/voronoi/ccd_stage2.hpp"
+#include "gl/compute.hpp"
+
+#include <cstddef>
+#include <string>
+
+namespace vproxq::gl {
+
+struct GlCcdVoxelOptions {
+  GLuint local_size = 64;  ///< work group size (LOCAL_SIZE define of the shader)
+  /// Largest key buffer of one batch in bytes; 0: GL_MAX_SHADER_STORAGE_BLOCK_SIZE. Records
+  /// are processed in batches whose key room fits (tests use small values to exercise it).
+  std::size_t max_batch_bytes = 0;
+};
+
+/// Lifetime and threading as GlVoronoiBackend: `context` must outlive the backend, stay in
+/// place and be current on the thread that uses it.
+class GlCcdVoxelBackend final : public CcdVoxelBackend {
+ public:
+  explicit GlCcdVoxelBackend(const Context& context, const GlCcdVoxelOptions& options = {});
+  std::string name() const override { return "gpu"; }
+  /// Throws GlError when a record's room alone exceeds the buffer limit or a GL call fails.
+  CcdVoxelOutput voxelize(const CcdVoxelInput& in) override;
+  std::size_t last_batch_count() const { return last_batch_count_; }
+
+ private:
+  const Context& context_;
+  GlCcdVoxelOptions options_;
+  ComputeProgram program_;
+  std::size_t last_batch_count_ = 0;
+};
+
+}  // namespace vproxq::gl
