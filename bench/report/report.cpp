@@ -12,6 +12,9 @@
 // summary.csv (the per-run averages behind the tables), fig13.dat/.gp and fig14.dat/.gp (gnuplot
 // scripts writing fig13.png and fig14.png; scripts/report.sh runs them). Times are the mean
 // per frame of the query time: vproxq's total minus loading the frame.
+// Every query's work is shown per mode (figure 13 per query): inter-object, intra-object,
+// intersection and CCD tests, each the mean over the frames where that query ran ("–" in the
+// report and an empty CSV field where it did not), and the query time split per query.
 // Nothing is measured here; a number missing from the inputs is reported as n/a.
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -38,7 +41,24 @@ namespace {
 const std::vector<std::string> kPaperOrder = {"skirt", "cloth-ball", "bowl", "funnel", "breaking"};
 const std::vector<std::string> kModes = {"off", "cpu", "gpu"};
 
+/// The queries whose exact tests the report shows separately (figure 13 per query): the
+/// inter-object distance (stats.exact_tests, on frames with distance.inter), the intra-object
+/// distance (stats.intra_exact_tests), the discrete intersection tests of the collision and PD
+/// queries (stats.intersection_tests) and CCD's elementary tests (stats.ccd.elementary_tests).
+enum QueryKind { kInter = 0, kIntra, kIntersect, kCcd, kQueryKinds };
+const char* const kQueryKey[kQueryKinds] = {"inter", "intra", "intersection", "ccd"};
+const char* const kQueryColumn[kQueryKinds] = {"inter_exact_tests", "intra_exact_tests",
+                                               "intersection_tests", "ccd_elementary_tests"};
+const char* const kQueryTitle[kQueryKinds] = {"inter-object exact tests", "intra-object exact tests",
+                                              "intersection tests", "CCD elementary tests"};
+
+/// Shown for a number whose query did not run (its key is absent from every frame).
+const char* const kNotRun = "–";
+
+using Opt = std::optional<double>;
+
 /// One frame of one run, the numbers of results.json's "stats" (or of vproxq-bench-fcl).
+/// Optional numbers are absent when their query did not run on the frame.
 struct FrameRow {
   int frame = 0;
   long long objects = 0, triangles = 0;        ///< all objects, static ones included
@@ -48,7 +68,29 @@ struct FrameRow {
   double exact_tests = 0, pns_pairs = 0, feature_pns = 0;
   double fcl_build = 0, fcl_query = 0, fcl_vproxq = 0;
   long long fcl_mismatches = 0;  ///< per-object distances where FCL and vproxq disagree
+  std::array<Opt, kQueryKinds> tests;  ///< exact tests per query (QueryKind)
+  Opt intra_candidates, intra_voronoi_culled;
+  Opt ccd_vf_tests, ccd_ee_tests, ccd_triangle_pairs, ccd_culled_triangles, ccd_limit_hits,
+      ccd_vf_pairs, ccd_ee_pairs;
+  Opt intra_bounds, intra_voronoi, intra_exact;  ///< stats.time_ms.intra_*
+  Opt ccd_aabb, ccd_voronoi, ccd_exact;          ///< stats.ccd.time_ms
   double query_ms() const { return total - load; }
+  /// The intra-object distance's share of the query time (its three stages).
+  Opt intra_ms() const {
+    if (!intra_bounds && !intra_voronoi && !intra_exact) return std::nullopt;
+    return intra_bounds.value_or(0) + intra_voronoi.value_or(0) + intra_exact.value_or(0);
+  }
+  /// CCD's share of the query time (stats.ccd.time_ms summed).
+  Opt ccd_ms() const {
+    if (!ccd_aabb && !ccd_voronoi && !ccd_exact) return std::nullopt;
+    return ccd_aabb.value_or(0) + ccd_voronoi.value_or(0) + ccd_exact.value_or(0);
+  }
+  /// The rest of the query time: inter-object distance, intersecting pairs and PD (absent when
+  /// none of them ran on the frame).
+  Opt inter_pairs_pd_ms() const {
+    if (!tests[kInter] && !tests[kIntersect]) return std::nullopt;
+    return query_ms() - intra_ms().value_or(0) - ccd_ms().value_or(0);
+  }
 };
 
 struct Run {
@@ -74,7 +116,18 @@ std::string slurp(const fs::path& p) {
 }
 
 double number(const json& j, const char* key) {
-  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : 0.0;
+  return j.is_object() && j.contains(key) && j[key].is_number() ? j[key].get<double>() : 0.0;
+}
+
+/// The number at j[key], absent when j is no object or has no such number.
+Opt optional_number(const json& j, const char* key) {
+  if (!j.is_object() || !j.contains(key) || !j[key].is_number()) return std::nullopt;
+  return j[key].get<double>();
+}
+
+/// j[key] when it is an object, else an empty object (absent stats blocks).
+json object_at(const json& j, const char* key) {
+  return j.is_object() && j.contains(key) && j[key].is_object() ? j[key] : json::object();
 }
 
 Run read_vproxq_run(const std::string& name, const fs::path& dir) {
@@ -109,8 +162,8 @@ Run read_vproxq_run(const std::string& name, const fs::path& dir) {
         r.static_triangles += o.value("triangles", 0LL);
       }
     }
-    const json& st = f.value("stats", json::object());
-    const json& t = st.value("time_ms", json::object());
+    const json st = object_at(f, "stats");
+    const json t = object_at(st, "time_ms");
     r.load = number(t, "load");
     r.aabb = number(t, "aabb");
     r.voronoi = number(t, "voronoi");
@@ -119,7 +172,33 @@ Run read_vproxq_run(const std::string& name, const fs::path& dir) {
     r.exact_tests = number(st, "exact_tests");
     r.pns_pairs = number(st, "pns_pairs");
     r.feature_pns = number(st, "feature_pns");
-    if (st.contains("voronoi") && st["voronoi"].contains("grid"))
+    // stats.exact_tests is always written; it counts inter-object tests when distance ran.
+    const json distance = object_at(f, "distance");
+    if (distance.contains("inter")) r.tests[kInter] = optional_number(st, "exact_tests");
+    r.tests[kIntra] = optional_number(st, "intra_exact_tests");
+    r.tests[kIntersect] = optional_number(st, "intersection_tests");
+    r.intra_candidates = optional_number(st, "intra_candidates");
+    r.intra_voronoi_culled = optional_number(st, "intra_voronoi_culled");
+    r.intra_bounds = optional_number(t, "intra_bounds");
+    r.intra_voronoi = optional_number(t, "intra_voronoi");
+    r.intra_exact = optional_number(t, "intra_exact");
+    if (st.contains("ccd") && st["ccd"].is_object()) {
+      const json& c = st["ccd"];
+      r.tests[kCcd] = optional_number(c, "elementary_tests");
+      r.ccd_vf_tests = optional_number(c, "vf_tests");
+      r.ccd_ee_tests = optional_number(c, "ee_tests");
+      r.ccd_triangle_pairs = optional_number(c, "triangle_pairs");
+      r.ccd_culled_triangles = optional_number(c, "culled_triangles");
+      r.ccd_limit_hits = optional_number(c, "limit_hits");
+      r.ccd_vf_pairs = optional_number(c, "vf_pairs");
+      r.ccd_ee_pairs = optional_number(c, "ee_pairs");
+      const json ct = object_at(c, "time_ms");
+      r.ccd_aabb = optional_number(ct, "aabb");
+      r.ccd_voronoi = optional_number(ct, "voronoi");
+      r.ccd_exact = optional_number(ct, "exact");
+    }
+    if (st.contains("voronoi") && st["voronoi"].is_object() && st["voronoi"].contains("grid") &&
+        st["voronoi"]["grid"].is_array() && st["voronoi"]["grid"].size() == 3)
       for (int k = 0; k < 3; ++k) r.grid[static_cast<size_t>(k)] = st["voronoi"]["grid"][static_cast<size_t>(k)].get<long long>();
     run.frames.push_back(r);
   }
@@ -181,6 +260,18 @@ std::vector<Scene> read_scenes(const fs::path& runs_dir) {
   return scenes;
 }
 
+/// Mean of an optional per-frame number over the frames where it is present.
+struct Mean {
+  double sum = 0;
+  std::size_t frames = 0;
+  void add(const Opt& v) {
+    if (!v) return;
+    sum += *v;
+    ++frames;
+  }
+  Opt mean() const { return frames ? Opt(sum / static_cast<double>(frames)) : std::nullopt; }
+};
+
 /// Means over the frames of a run.
 struct Summary {
   bool ok = false;
@@ -193,6 +284,14 @@ struct Summary {
   double exact_tests = 0, pns_pairs = 0, feature_pns = 0;
   double fcl_build = 0, fcl_query = 0, fcl_vproxq = 0;
   long long fcl_mismatches = 0;  ///< summed over the frames
+  /// Per query: exact tests, mean over the frames where the query ran.
+  std::array<Mean, kQueryKinds> tests;
+  Mean intra_candidates, intra_voronoi_culled, ccd_vf_tests, ccd_ee_tests, ccd_triangle_pairs,
+      ccd_culled_triangles, ccd_limit_hits, ccd_vf_pairs, ccd_ee_pairs;
+  /// The query time split per query, mean over all frames of the run (0 on a frame where the
+  /// query did not run, so that the three add up to query_ms); absent when it never ran.
+  Opt inter_pairs_pd_ms, intra_ms, ccd_ms;
+  Opt test_mean(int q) const { return tests[static_cast<std::size_t>(q)].mean(); }
 };
 
 Summary summarize(const Run* run) {
@@ -217,7 +316,21 @@ Summary summarize(const Run* run) {
   s.static_objects = run->frames.front().static_objects;
   s.grid = run->frames.front().grid;
   const double n = static_cast<double>(s.frames);
+  Mean inter_ms, intra_ms, ccd_ms;
   for (const FrameRow& f : run->frames) {
+    for (std::size_t q = 0; q < s.tests.size(); ++q) s.tests[q].add(f.tests[q]);
+    s.intra_candidates.add(f.intra_candidates);
+    s.intra_voronoi_culled.add(f.intra_voronoi_culled);
+    s.ccd_vf_tests.add(f.ccd_vf_tests);
+    s.ccd_ee_tests.add(f.ccd_ee_tests);
+    s.ccd_triangle_pairs.add(f.ccd_triangle_pairs);
+    s.ccd_culled_triangles.add(f.ccd_culled_triangles);
+    s.ccd_limit_hits.add(f.ccd_limit_hits);
+    s.ccd_vf_pairs.add(f.ccd_vf_pairs);
+    s.ccd_ee_pairs.add(f.ccd_ee_pairs);
+    inter_ms.add(f.inter_pairs_pd_ms());
+    intra_ms.add(f.intra_ms());
+    ccd_ms.add(f.ccd_ms());
     s.triangles_max = std::max(s.triangles_max, f.triangles);
     s.objects_max = std::max(s.objects_max, f.objects);
     s.query_ms += f.query_ms() / n;
@@ -233,6 +346,12 @@ Summary summarize(const Run* run) {
     s.fcl_vproxq += f.fcl_vproxq / n;
     s.fcl_mismatches += f.fcl_mismatches;
   }
+  auto over_all_frames = [&](const Mean& m) {
+    return m.frames ? Opt(m.sum / n) : std::nullopt;
+  };
+  s.inter_pairs_pd_ms = over_all_frames(inter_ms);
+  s.intra_ms = over_all_frames(intra_ms);
+  s.ccd_ms = over_all_frames(ccd_ms);
   return s;
 }
 
@@ -278,6 +397,22 @@ std::string ms_cell(const Summary& s) { return s.ok ? fixed(s.query_ms, 1) : "n/
 std::string ratio_cell(const Summary& a, const Summary& b, double Summary::*field) {
   if (!a.ok || !b.ok || !(b.*field > 0)) return "n/a";
   return fixed(a.*field / b.*field, 2);
+}
+
+/// A mean count, or "–" when its query did not run.
+std::string count_cell(const Opt& v) { return v ? count(*v) : kNotRun; }
+
+/// A mean time in ms, or "–" when its query did not run.
+std::string ms_cell(const Opt& v) { return v ? fixed(*v, 1) : kNotRun; }
+
+/// Reduction of query q's exact tests: off's mean over `mode`'s. "–" when the query ran in
+/// neither, "n/a" when one of the runs failed, the query ran in only one, or `mode` did none.
+std::string reduction_cell(const Summary& off, const Summary& m, int q) {
+  if (!off.ok || !m.ok) return "n/a";
+  const Opt a = off.test_mean(q), b = m.test_mean(q);
+  if (!a && !b) return kNotRun;
+  if (!a || !b || !(*b > 0)) return "n/a";
+  return fixed(*a / *b, 2);
 }
 
 int grid_of(const std::string& run) { return std::stoi(run.substr(5)); }
@@ -363,24 +498,59 @@ std::string report_markdown(const std::vector<Scene>& scenes, const std::string&
   }
 
   md << "\n## Stages (ms per frame) and exact tests (figure 13)\n\n";
-  md << "Exact tests: triangle pairs whose exact distance was computed (Stage III), mean per "
-        "frame. Reduction: off / Voronoi.\n\n";
-  md << "| Benchmark | mode | AABB | Voronoi | exact | query | exact tests | object PNS pairs "
-        "| feature PNS | reduction |\n";
-  md << "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-  for (const Scene& s : scenes) {
-    const Summary off = summarize(find_run(s, "off"));
+  md << "Stage times, mean per frame over all queries of the run (the 2-ring bounds of the "
+        "intra-object distance and CCD's swept boxes count as AABB, both Voronoi diagrams and "
+        "CCD's voxel culling as Voronoi), and the query time split per query: intra = "
+        "`intra_bounds + intra_voronoi + intra_exact`, CCD = the sum of `stats.ccd.time_ms`, "
+        "inter + pairs + PD = the rest (inter-object distance, intersecting pairs, penetration "
+        "depth). The split is the mean over all frames (0 on a frame where the query did not "
+        "run, e.g. CCD on the last frame), so it adds up to the query time; – where the query "
+        "did not run.\n\n";
+  md << "| Benchmark | mode | AABB | Voronoi | exact | query | inter + pairs + PD | intra | CCD "
+        "| object PNS pairs | feature PNS |\n";
+  md << "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const Scene& s : scenes)
     for (const std::string& mode : kModes) {
       const Summary m = summarize(find_run(s, mode));
       if (!m.ok) {
-        md << "| " << s.name << " | " << mode << " | n/a | n/a | n/a | n/a | n/a | n/a | n/a | n/a |\n";
+        md << "| " << s.name << " | " << mode
+           << " | n/a | n/a | n/a | n/a | n/a | n/a | n/a | n/a | n/a |\n";
         continue;
       }
       md << "| " << s.name << " | " << mode << " | " << fixed(m.aabb, 1) << " | "
          << fixed(m.voronoi, 1) << " | " << fixed(m.exact, 1) << " | " << fixed(m.query_ms, 1)
-         << " | " << count(m.exact_tests) << " | " << count(m.pns_pairs) << " | "
-         << count(m.feature_pns) << " | "
-         << (mode == "off" ? "1" : ratio_cell(off, m, &Summary::exact_tests)) << " |\n";
+         << " | " << ms_cell(m.inter_pairs_pd_ms) << " | " << ms_cell(m.intra_ms) << " | "
+         << ms_cell(m.ccd_ms) << " | " << count(m.pns_pairs) << " | " << count(m.feature_pns)
+         << " |\n";
+    }
+
+  md << "\n## Exact tests per query (figure 13)\n\n";
+  md << "Mean per frame over the frames where the query ran: inter-object exact tests "
+        "(`stats.exact_tests`, triangle pairs whose exact distance was computed in Stage III), "
+        "intra-object exact tests (`stats.intra_exact_tests`), intersection tests of the "
+        "intersecting pairs behind collisions and PD (`stats.intersection_tests`) and CCD "
+        "elementary tests (`stats.ccd.elementary_tests`, vertex-face plus edge-edge; frames "
+        "with a next frame). Reduction: off / mode. –: the query did not run.\n\n";
+  md << "| Benchmark | mode";
+  for (int q = 0; q < kQueryKinds; ++q) md << " | " << kQueryTitle[q] << " | reduction";
+  md << " |\n|---|---";
+  for (int q = 0; q < kQueryKinds; ++q) md << "|---:|---:";
+  md << "|\n";
+  for (const Scene& s : scenes) {
+    const Summary off = summarize(find_run(s, "off"));
+    for (const std::string& mode : kModes) {
+      const Summary m = summarize(find_run(s, mode));
+      md << "| " << s.name << " | " << mode;
+      for (int q = 0; q < kQueryKinds; ++q) {
+        if (!m.ok) {
+          md << " | n/a | n/a";
+          continue;
+        }
+        const Opt v = m.test_mean(q);
+        md << " | " << count_cell(v) << " | "
+           << (mode == "off" ? (v ? "1" : kNotRun) : reduction_cell(off, m, q));
+      }
+      md << " |\n";
     }
   }
 
@@ -455,21 +625,44 @@ std::string report_markdown(const std::vector<Scene>& scenes, const std::string&
   return md.str();
 }
 
+/// A CSV field: the number, or empty when absent.
+std::string csv_opt(const Opt& v) {
+  if (!v) return "";
+  std::ostringstream o;
+  o.precision(10);
+  o << *v;
+  return o.str();
+}
+
 std::string csv_all(const std::vector<Scene>& scenes) {
   std::ostringstream csv;
   csv << "scene,run,frame,objects,triangles,grid_x,grid_y,grid_z,load_ms,aabb_ms,voronoi_ms,"
          "exact_ms,total_ms,query_ms,exact_tests,pns_pairs,feature_pns,fcl_build_ms,"
-         "fcl_query_ms,fcl_vproxq_ms,fcl_mismatches\n";
+         "fcl_query_ms,fcl_vproxq_ms,fcl_mismatches";
+  for (const char* c : kQueryColumn) csv << ',' << c;
+  csv << ",intra_candidates,intra_voronoi_culled,"
+         "ccd_vf_tests,ccd_ee_tests,ccd_triangle_pairs,ccd_culled_triangles,ccd_limit_hits,"
+         "ccd_vf_pairs,ccd_ee_pairs,intra_bounds_ms,intra_voronoi_ms,intra_exact_ms,"
+         "ccd_aabb_ms,ccd_voronoi_ms,ccd_exact_ms,inter_pairs_pd_ms,intra_ms,ccd_ms\n";
   csv.precision(10);
   for (const Scene& s : scenes)
     for (const auto& [name, run] : s.runs)
-      for (const FrameRow& f : run.frames)
+      for (const FrameRow& f : run.frames) {
         csv << s.name << ',' << name << ',' << f.frame << ',' << f.objects << ',' << f.triangles
             << ',' << f.grid[0] << ',' << f.grid[1] << ',' << f.grid[2] << ',' << f.load << ','
             << f.aabb << ',' << f.voronoi << ',' << f.exact << ',' << f.total << ','
             << (name == "fcl" ? 0.0 : f.query_ms()) << ',' << f.exact_tests << ',' << f.pns_pairs
             << ',' << f.feature_pns << ',' << f.fcl_build << ',' << f.fcl_query << ','
-            << f.fcl_vproxq << ',' << f.fcl_mismatches << '\n';
+            << f.fcl_vproxq << ',' << f.fcl_mismatches;
+        for (const Opt& v : {f.tests[kInter], f.tests[kIntra], f.tests[kIntersect], f.tests[kCcd],
+                             f.intra_candidates, f.intra_voronoi_culled, f.ccd_vf_tests,
+                             f.ccd_ee_tests, f.ccd_triangle_pairs, f.ccd_culled_triangles,
+                             f.ccd_limit_hits, f.ccd_vf_pairs, f.ccd_ee_pairs, f.intra_bounds,
+                             f.intra_voronoi, f.intra_exact, f.ccd_aabb, f.ccd_voronoi,
+                             f.ccd_exact, f.inter_pairs_pd_ms(), f.intra_ms(), f.ccd_ms()})
+          csv << ',' << csv_opt(v);
+        csv << '\n';
+      }
   return csv.str();
 }
 
@@ -477,9 +670,17 @@ std::string csv_summary(const std::vector<Scene>& scenes) {
   std::ostringstream csv;
   csv << "scene,run,status,frames,triangles_first,triangles_max,objects_first,objects_max,"
          "grid_x,grid_y,grid_z,query_ms,load_ms,aabb_ms,voronoi_ms,exact_ms,exact_tests,"
-         "pns_pairs,feature_pns,fcl_build_ms,fcl_query_ms,fcl_vproxq_ms,fcl_mismatches\n";
+         "pns_pairs,feature_pns,fcl_build_ms,fcl_query_ms,fcl_vproxq_ms,fcl_mismatches";
+  for (int q = 0; q < kQueryKinds; ++q) {
+    const std::string k = kQueryKey[q];
+    csv << ',' << kQueryColumn[q] << ',' << k << "_frames," << k << "_reduction";
+  }
+  csv << ",intra_candidates,intra_voronoi_culled,ccd_vf_tests,ccd_ee_tests,ccd_triangle_pairs,"
+         "ccd_culled_triangles,ccd_limit_hits,ccd_vf_pairs,ccd_ee_pairs,inter_pairs_pd_ms,"
+         "intra_ms,ccd_ms\n";
   csv.precision(10);
-  for (const Scene& s : scenes)
+  for (const Scene& s : scenes) {
+    const Summary off = summarize(find_run(s, "off"));
     for (const auto& [name, run] : s.runs) {
       const Summary m = summarize(&run);
       std::string status = m.ok ? "ok" : reason(m.error);
@@ -490,41 +691,86 @@ std::string csv_summary(const std::vector<Scene>& scenes) {
           << m.grid[0] << ',' << m.grid[1] << ',' << m.grid[2] << ',' << m.query_ms << ','
           << m.load << ',' << m.aabb << ',' << m.voronoi << ',' << m.exact << ','
           << m.exact_tests << ',' << m.pns_pairs << ',' << m.feature_pns << ',' << m.fcl_build
-          << ',' << m.fcl_query << ',' << m.fcl_vproxq << ',' << m.fcl_mismatches << '\n';
+          << ',' << m.fcl_query << ',' << m.fcl_vproxq << ',' << m.fcl_mismatches;
+      // Reductions (off / this run) for the Stage II modes; the grid runs use --voronoi=cpu.
+      const bool voronoi_run = name != "fcl";
+      for (int q = 0; q < kQueryKinds; ++q) {
+        const Opt v = m.test_mean(q);
+        std::string red;
+        if (voronoi_run && off.ok && m.ok && v && off.test_mean(q) && *v > 0)
+          red = csv_opt(*off.test_mean(q) / *v);
+        csv << ',' << csv_opt(v) << ',' << m.tests[static_cast<std::size_t>(q)].frames << ','
+            << red;
+      }
+      for (const Opt& v : {m.intra_candidates.mean(), m.intra_voronoi_culled.mean(),
+                           m.ccd_vf_tests.mean(), m.ccd_ee_tests.mean(),
+                           m.ccd_triangle_pairs.mean(), m.ccd_culled_triangles.mean(),
+                           m.ccd_limit_hits.mean(), m.ccd_vf_pairs.mean(), m.ccd_ee_pairs.mean(),
+                           m.inter_pairs_pd_ms, m.intra_ms, m.ccd_ms})
+        csv << ',' << csv_opt(v);
+      csv << '\n';
     }
+  }
   return csv.str();
 }
 
-/// fig13.dat: one row per scene, mean exact tests per mode ("NaN" where the run is missing,
-/// or 0 tests, which a log scale cannot show).
+/// fig13.dat: one row per scene, mean exact tests per query and mode (columns 2-4: inter
+/// off/cpu/gpu, 5-7 intra, 8-10 intersection, 11-13 CCD; "NaN" where the run is missing, the
+/// query did not run, or 0 tests, which a log scale cannot show). fig13.gp draws one panel per
+/// query (a clustered histogram of the modes per scene); a query with no data anywhere gets an
+/// empty panel that says so.
 void write_fig13(const std::vector<Scene>& scenes, const fs::path& out) {
   std::ostringstream dat;
-  dat << "# scene off cpu gpu (mean exact tests per frame)\n";
+  dat << "# scene";
+  for (int q = 0; q < kQueryKinds; ++q)
+    for (const std::string& mode : kModes) dat << ' ' << kQueryKey[q] << '_' << mode;
+  dat << " (mean exact tests per frame)\n";
+  std::array<double, kQueryKinds> top{};  ///< largest value shown per query (0: none)
   for (const Scene& s : scenes) {
     dat << s.name;
-    for (const std::string& mode : kModes) {
-      const Summary m = summarize(find_run(s, mode));
-      dat << ' ' << (m.ok && m.exact_tests > 0 ? fixed(m.exact_tests, 1) : "NaN");
-    }
+    std::vector<Summary> m;
+    for (const std::string& mode : kModes) m.push_back(summarize(find_run(s, mode)));
+    for (int q = 0; q < kQueryKinds; ++q)
+      for (const Summary& r : m) {
+        const Opt v = r.ok ? r.test_mean(q) : std::nullopt;
+        const bool shown = v && *v > 0;
+        if (shown) top[static_cast<std::size_t>(q)] = std::max(top[static_cast<std::size_t>(q)], *v);
+        dat << ' ' << (shown ? fixed(*v, 1) : "NaN");
+      }
     dat << '\n';
   }
   write_text(out / "fig13.dat", dat.str());
-  write_text(out / "fig13.gp",
-             "# gnuplot fig13.gp (in this folder) writes fig13.png: the paper's figure 13.\n"
-             "set terminal pngcairo size 900,540 noenhanced font ',11'\n"
-             "set output 'fig13.png'\n"
-             "set title 'Exact triangle-pair tests per frame: AABB only vs. Voronoi culling'\n"
-             "set datafile missing 'NaN'\n"
-             "set style data histograms\n"
-             "set style histogram clustered gap 1\n"
-             "set style fill solid 0.8 border -1\n"
-             "set logscale y\n"
-             "set yrange [1:*]\n"
-             "set ylabel 'mean exact tests per frame (log scale)'\n"
-             "set grid ytics\n"
-             "set key top left\n"
-             "plot 'fig13.dat' using 2:xtic(1) title 'off (AABB)', '' using 3 title 'cpu "
-             "(Voronoi)', '' using 4 title 'gpu (Voronoi)'\n");
+  std::ostringstream gp;
+  gp << "# gnuplot fig13.gp (in this folder) writes fig13.png: the paper's figure 13, one panel "
+        "per query.\n"
+        "set terminal pngcairo size 1200,900 noenhanced font ',11'\n"
+        "set output 'fig13.png'\n"
+        "set datafile missing 'NaN'\n"
+        "set style data histograms\n"
+        "set style histogram clustered gap 1\n"
+        "set style fill solid 0.8 border -1\n"
+        "set grid ytics\n"
+        "set multiplot layout 2,2 title 'Exact tests per frame: AABB only vs. Voronoi culling "
+        "(log scale)'\n";
+  for (int q = 0; q < kQueryKinds; ++q) {
+    const int col = 2 + 3 * q;
+    gp << "set title '" << kQueryTitle[q] << "'\n";
+    const double max = top[static_cast<std::size_t>(q)];
+    if (max > 0) {
+      // A decade of room above the tallest bar.
+      gp << "set logscale y\nset yrange [1:" << fixed(std::max(10.0, max * 10), 0)
+         << "]\nset ylabel 'mean per frame'\nset xtics\nset ytics\nset key below horizontal\n"
+            "plot 'fig13.dat' using " << col << ":xtic(1) title 'off (AABB)', '' using "
+         << col + 1 << " title 'cpu (Voronoi)', '' using " << col + 2 << " title 'gpu (Voronoi)'\n";
+    } else {
+      gp << "unset logscale y\nset yrange [0:1]\nunset ylabel\nunset xtics\nunset ytics\nunset key\n"
+            "set label 1 'not run' at graph 0.5, graph 0.5 center\n"
+            "plot [0:1] NaN notitle\n"
+            "unset label 1\n";
+    }
+  }
+  gp << "unset multiplot\n";
+  write_text(out / "fig13.gp", gp.str());
 }
 
 /// fig14.dat: one block per scene with a grid sweep (gnuplot `index`), a row per grid.
