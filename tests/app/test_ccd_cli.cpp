@@ -5,7 +5,7 @@
 #include "core/query/ccd.hpp"
 #include "io/hdf5_reader.hpp"
 #include "io/scene_source.hpp"
-#include "support/process.hpp"
+#include "support/cli.hpp"
 #include "support/random_scene.hpp"
 
 #include <gtest/gtest.h>
@@ -18,31 +18,10 @@ namespace {
 
 namespace fs = std::filesystem;
 using test::quote;
-using test::run_command;
 using test::ScratchDir;
-
-const std::string kVproxq = VPROXQ_BINARY;
-
-test::ProcessResult vproxq(const std::string& args) { return run_command(kVproxq + " " + args); }
-
-nlohmann::json read_json(const fs::path& p) {
-  std::ifstream in(p);
-  return nlohmann::json::parse(in);
-}
-
-/// One OBJ per frame, an `o` group per object, 17 significant digits (exact round trip).
-void write_obj(const Frame& frame, const fs::path& file) {
-  std::ofstream out(file);
-  out.precision(17);
-  Index base = 1;
-  for (const Object& o : frame.objects) {
-    out << "o " << o.name << "\n";
-    for (const Vec3& p : o.positions) out << "v " << p.x() << " " << p.y() << " " << p.z() << "\n";
-    for (const Face& f : o.topology->faces)
-      out << "f " << f[0] + base << " " << f[1] + base << " " << f[2] + base << "\n";
-    base += o.num_vertices();
-  }
-}
+using test::read_json;
+using test::vproxq;
+using test::write_obj;
 
 /// Frame `prev` with every object drifted and its vertices jittered (same topologies).
 Frame moved(const Frame& prev, test::Rng& rng, double drift, double jitter) {
