@@ -2,6 +2,8 @@
 // Exact-as-double triangle–triangle distance with closest points and the winning feature case.
 #include "core/types.hpp"
 
+#include <utility>
+
 namespace vproxq {
 
 /// Which feature pair realises the distance between triangles A and B.
@@ -37,6 +39,22 @@ struct TriangleDistanceResult {
 /// equal inputs give bitwise equal results. Inputs must be finite; exactness of the intersection
 /// decision holds for coordinates of magnitude in [2^-200, 2^200] or zero (predicates.hpp).
 TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b);
+
+/// triangle_distance(a, b) when `a_first`, else triangle_distance(b, a) seen from a's side
+/// (points, features and the vertex–face case swapped). Callers that must get bitwise the
+/// same numbers for (a, b) and (b, a) pass a fixed order, e.g. "lower id first".
+inline TriangleDistanceResult triangle_distance_ordered(const Triangle& a, const Triangle& b,
+                                                        bool a_first) {
+  if (a_first) return triangle_distance(a, b);
+  TriangleDistanceResult r = triangle_distance(b, a);
+  std::swap(r.point_a, r.point_b);
+  std::swap(r.feature_a, r.feature_b);
+  if (r.kind == TriangleDistanceCase::VertexFace)
+    r.kind = TriangleDistanceCase::FaceVertex;
+  else if (r.kind == TriangleDistanceCase::FaceVertex)
+    r.kind = TriangleDistanceCase::VertexFace;
+  return r;
+}
 
 /// True when the closed triangles a and b share at least one point (exact predicates). A
 /// degenerate triangle is the union of its edges. Defined in triangle_intersection.cpp, which

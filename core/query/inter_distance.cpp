@@ -46,15 +46,7 @@ struct Best {
 TriangleDistanceResult evaluate(const Frame& frame, Index i, Index ts, Index j, Index to) {
   const Object& oi = frame.objects[static_cast<size_t>(i)];
   const Object& oj = frame.objects[static_cast<size_t>(j)];
-  if (i < j) return triangle_distance(oi.triangle(ts), oj.triangle(to));
-  TriangleDistanceResult r = triangle_distance(oj.triangle(to), oi.triangle(ts));
-  std::swap(r.point_a, r.point_b);
-  std::swap(r.feature_a, r.feature_b);
-  if (r.kind == TriangleDistanceCase::VertexFace)
-    r.kind = TriangleDistanceCase::FaceVertex;
-  else if (r.kind == TriangleDistanceCase::FaceVertex)
-    r.kind = TriangleDistanceCase::VertexFace;
-  return r;
+  return triangle_distance_ordered(oi.triangle(ts), oj.triangle(to), i < j);
 }
 
 void consider(const Frame& frame, Index i, Index ts, Index j, Index to, Best& best) {

@@ -22,15 +22,7 @@ constexpr std::size_t kBlock = 64;
 /// Distance between triangles f and g of one object, always evaluated with the lower id first,
 /// so that f's and g's searches get bitwise the same numbers. Expressed from f's side.
 TriangleDistanceResult evaluate(const Object& o, Index f, Index g) {
-  if (f < g) return triangle_distance(o.triangle(f), o.triangle(g));
-  TriangleDistanceResult r = triangle_distance(o.triangle(g), o.triangle(f));
-  std::swap(r.point_a, r.point_b);
-  std::swap(r.feature_a, r.feature_b);
-  if (r.kind == TriangleDistanceCase::VertexFace)
-    r.kind = TriangleDistanceCase::FaceVertex;
-  else if (r.kind == TriangleDistanceCase::FaceVertex)
-    r.kind = TriangleDistanceCase::VertexFace;
-  return r;
+  return triangle_distance_ordered(o.triangle(f), o.triangle(g), f < g);
 }
 
 /// Keeps the smallest (distance, g): the tie-break shared with the brute force.
