@@ -138,6 +138,32 @@ double mean_edge_length(const Mesh& m) {
   return sum / static_cast<double>(edges.size());
 }
 
+/// Letter i of a letters scene: glyph `mesh`, named "letter<i>_<char>", contact radius half
+/// its mean edge length.
+SoftLetter add_scene_letter(World& w, Rng& rng, const Mesh& mesh, int i, const V3& start) {
+  return add_letter(w, rng, mesh, std::string("letter") + std::to_string(i) + "_" + glyph_char(i),
+                    start, 0.5 * mean_edge_length(mesh));
+}
+
+/// Simulates a letters scene for `duration` seconds at kLetterDt and writes `frames` frames of
+/// its letters (the static geometry is written by the caller).
+void run_letters(World& w, const std::vector<SoftLetter>& letters, int frames, double duration,
+                 SceneWriter& out) {
+  auto step = [&](double t) {
+    for (const SoftLetter& s : letters) breathe(w, s, t + kLetterDt);
+    w.substep(kLetterDt);
+  };
+  run_schedule(frames, static_cast<long long>(duration / kLetterDt + 0.5), kLetterDt, step,
+               [&](int k, double t) {
+                 out.begin_frame(k, t);
+                 for (const SoftLetter& s : letters)
+                   out.add_object(s.name, particle_positions(w, s.first, s.mesh->positions.size()),
+                                  s.mesh->faces);
+                 out.end_frame();
+               });
+  out.finish("meshes");
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -337,23 +363,9 @@ void generate_bowl(const BowlOptions& o, SceneWriter& out) {
     // Dropped one above the other, a little off the axis, so they land on each other.
     const double a = rng.uniform(0, kTwoPi), r = rng.uniform(0, 0.8);
     const V3 start{r * det_cos(a), r * det_sin(a), 2.0 + 0.9 * i};
-    letters.push_back(add_letter(w, rng, m,
-                                 std::string("letter") + std::to_string(i) + "_" + glyph_char(i),
-                                 start, 0.5 * mean_edge_length(m)));
+    letters.push_back(add_scene_letter(w, rng, m, i, start));
   }
-  auto step = [&](double t) {
-    for (const SoftLetter& s : letters) breathe(w, s, t + kLetterDt);
-    w.substep(kLetterDt);
-  };
-  run_schedule(o.frames, static_cast<long long>(kDuration / kLetterDt + 0.5), kLetterDt, step,
-               [&](int k, double t) {
-                 out.begin_frame(k, t);
-                 for (const SoftLetter& s : letters)
-                   out.add_object(s.name, particle_positions(w, s.first, s.mesh->positions.size()),
-                                  s.mesh->faces);
-                 out.end_frame();
-               });
-  out.finish("meshes");
+  run_letters(w, letters, o.frames, kDuration, out);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -414,23 +426,9 @@ void generate_funnel(const FunnelOptions& o, SceneWriter& out) {
     const double jy = rng.uniform(-0.08, 0.08);
     const V3 start{slot[0] + jx, slot[1] + jy, kTopZ + 0.6 + kSpacing * layer};
     const Mesh& mesh = glyphs[static_cast<size_t>(i % kGlyphCount)];
-    letters.push_back(add_letter(w, rng, mesh,
-                                 std::string("letter") + std::to_string(i) + "_" + glyph_char(i),
-                                 start, 0.5 * mean_edge_length(mesh)));
+    letters.push_back(add_scene_letter(w, rng, mesh, i, start));
   }
-  auto step = [&](double t) {
-    for (const SoftLetter& s : letters) breathe(w, s, t + kLetterDt);
-    w.substep(kLetterDt);
-  };
-  run_schedule(o.frames, static_cast<long long>(kDuration / kLetterDt + 0.5), kLetterDt, step,
-               [&](int k, double t) {
-                 out.begin_frame(k, t);
-                 for (const SoftLetter& s : letters)
-                   out.add_object(s.name, particle_positions(w, s.first, s.mesh->positions.size()),
-                                  s.mesh->faces);
-                 out.end_frame();
-               });
-  out.finish("meshes");
+  run_letters(w, letters, o.frames, kDuration, out);
 }
 
 // ---------------------------------------------------------------------------------------------
