@@ -495,6 +495,49 @@ std::vector<Index> overlapping_triangles(const Object& o, const std::vector<Inde
   return out;
 }
 
+/// Completes an entry whose direction holds the deepest pair's vector (`best` its length, 0
+/// when no vertex lies strictly inside): the unit direction T and the depth, the width of
+/// `points` along T. With no vertex strictly inside (a shallow overlap, or faces lying on each
+/// other, as for two boxes sliding into each other face to face) the paper's distance pairs are
+/// all 0: T is then the overlapping face normal along which the overlap is narrowest (for a
+/// convex overlap, a facet normal is a candidate minimal translation direction), times
+/// `sign[side]` so that it points the way objects[0]'s side must move; Shallow when every
+/// overlapping face is degenerate.
+PenetrationDepth finish_depth(PenetrationDepth& pd, double best, const std::vector<Vec3>& points,
+                              const std::array<const Object*, 2>& owner,
+                              const std::array<double, 2>& sign) {
+  if (best > 0) {
+    pd.direction /= pd.direction.norm();
+    pd.depth = width(points, pd.direction);
+    pd.status = PdStatus::Ok;
+    return pd;
+  }
+  pd.deepest_object = pd.deepest_vertex = kNoIndex;
+  pd.deepest_point = pd.nearest_point = Vec3::Zero();
+  double narrowest = kInfinity;
+  for (size_t side = 0; side < 2; ++side)
+    for (Index t : pd.overlapping_triangles[side]) {
+      const Triangle tri = owner[side]->triangle(t);
+      Vec3 n = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
+      const double len = n.norm();
+      if (!(len > 0)) continue;
+      n /= len;
+      const double w = width(points, n);
+      if (w < narrowest) {
+        narrowest = w;
+        pd.direction = sign[side] * n;
+      }
+    }
+  if (narrowest == kInfinity) {
+    pd.status = PdStatus::Shallow;
+    pd.direction = Vec3::Zero();
+    return pd;
+  }
+  pd.depth = narrowest;
+  pd.status = PdStatus::Ok;
+  return pd;
+}
+
 // ---------------------------------------------------------------------------------------
 // Self-intersections: the local walk within one object.
 //
@@ -658,39 +701,9 @@ PenetrationDepth self_contact_depth(SelfContext& ctx, Index object, const std::v
   std::vector<Vec3> points;
   for (const IntersectingPair& p : pairs) intersection_vertices(o.triangle(p.tri_a), o.triangle(p.tri_b), points);
   for (Index v : walk.inside) points.push_back(o.positions[static_cast<size_t>(v)]);
-  if (best > 0) {
-    pd.direction /= pd.direction.norm();
-    pd.depth = width(points, pd.direction);
-    pd.status = PdStatus::Ok;
-    return pd;
-  }
-  // No vertex strictly inside another sheet: as between objects, the overlapping face
-  // normal along which the overlap is narrowest; T = -n translates that face's sheet back
-  // (the other sheet lies on its outward side).
-  pd.deepest_object = pd.deepest_vertex = kNoIndex;
-  pd.deepest_point = pd.nearest_point = Vec3::Zero();
-  double narrowest = kInfinity;
-  for (int side = 0; side < 2; ++side)
-    for (Index t : tris[static_cast<size_t>(side)]) {
-      const Triangle tri = o.triangle(t);
-      Vec3 n = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
-      const double len = n.norm();
-      if (!(len > 0)) continue;
-      n /= len;
-      const double w = width(points, n);
-      if (w < narrowest) {
-        narrowest = w;
-        pd.direction = -n;
-      }
-    }
-  if (narrowest == kInfinity) {
-    pd.status = PdStatus::Shallow;
-    pd.direction = Vec3::Zero();
-    return pd;
-  }
-  pd.depth = narrowest;
-  pd.status = PdStatus::Ok;
-  return pd;
+  // The overlapping faces of both sides are this object's; T = -n translates a face's
+  // sheet back (the other sheet lies on its outward side).
+  return finish_depth(pd, best, points, {&o, &o}, {-1.0, -1.0});
 }
 
 /// The entry of a self-intersecting object: its contacts (see above), reported as the first
@@ -812,43 +825,8 @@ PenetrationDepth pair_depth(const std::vector<ObjectView>& views,
     intersection_vertices(va.object->triangle(it->tri_a), vb.object->triangle(it->tri_b), points);
   for (Index v : wa.inside) points.push_back(va.object->positions[static_cast<size_t>(v)]);
   for (Index v : wb.inside) points.push_back(vb.object->positions[static_cast<size_t>(v)]);
-  if (best > 0) {
-    pd.direction /= pd.direction.norm();
-    pd.depth = width(points, pd.direction);
-    pd.status = PdStatus::Ok;
-    return pd;
-  }
-  // No vertex lies strictly inside the other object (a shallow overlap, or faces lying on
-  // each other, as for two boxes sliding into each other face to face): the paper's distance
-  // pairs are all 0. T is then the overlapping face normal along which the overlap is
-  // narrowest (for a convex overlap, a facet normal is a candidate minimal translation
-  // direction), pointing out of B: +n for B's faces, -n for A's (outward normals).
-  pd.deepest_object = pd.deepest_vertex = kNoIndex;
-  pd.deepest_point = pd.nearest_point = Vec3::Zero();
-  double narrowest = kInfinity;
-  for (int side = 0; side < 2; ++side) {
-    const ObjectView& own = side == 0 ? va : vb;
-    for (Index t : pd.overlapping_triangles[static_cast<size_t>(side)]) {
-      const Triangle tri = own.object->triangle(t);
-      Vec3 n = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
-      const double len = n.norm();
-      if (!(len > 0)) continue;
-      n /= len;
-      const double w = width(points, n);
-      if (w < narrowest) {
-        narrowest = w;
-        pd.direction = side == 0 ? Vec3(-n) : n;
-      }
-    }
-  }
-  if (narrowest == kInfinity) {
-    pd.status = PdStatus::Shallow;
-    pd.direction = Vec3::Zero();
-    return pd;
-  }
-  pd.depth = narrowest;
-  pd.status = PdStatus::Ok;
-  return pd;
+  // Face normals point out of B: +n for B's faces, -n for A's (outward normals).
+  return finish_depth(pd, best, points, {va.object, vb.object}, {-1.0, 1.0});
 }
 
 }  // namespace
