@@ -44,4 +44,22 @@ std::vector<std::uint32_t> pack_samples(const DvdInput& in, std::size_t first, s
 /// float (the margin must not shrink; see dvd2_gather.comp).
 void set_dvd_uniforms(ComputeProgram& program, const DvdInput& in, double error_bound);
 
+/// Runs one dispatch per batch (each batch has `count` samples; bind_batch(batch) binds its
+/// own buffers; the shared ones are bound already) and waits for the shader writes: the
+/// compute time in ms. Adds the dispatches to `dispatch_count`.
+template <typename Batches, typename Bind>
+double dispatch_batches(const Context& context, ComputeProgram& program, const Batches& batches,
+                        const Bind& bind_batch, std::size_t& dispatch_count) {
+  const auto local_size = static_cast<GLuint>(program.local_size()[0]);
+  return finish_timed_ms(context, [&] {
+    for (const auto& batch : batches) {
+      bind_batch(batch);
+      program.set_uint("sample_count", static_cast<GLuint>(batch.count));
+      dispatch(context, program, group_count(batch.count, local_size));
+      ++dispatch_count;
+    }
+    memory_barrier(context);
+  });
+}
+
 }  // namespace vproxq::gl

@@ -77,18 +77,11 @@ SelfDvdOutput GlSelfVoronoiBackend::compute(const SelfDvdInput& self) {
   set_dvd_uniforms(program_, in, GlVoronoiBackend::float32_error_bound(dvd_input_extent(in)));
   shared->bind();
   vertices->bind(7);
-  const auto local_size = static_cast<GLuint>(program_.local_size()[0]);
-  out.compute_ms = finish_timed_ms(context_, [&] {
-    for (const Batch& batch : batches) {
-      batch.samples.bind(4);
-      batch.results.bind(5);
-      batch.sample_triangles.bind(6);
-      program_.set_uint("sample_count", static_cast<GLuint>(batch.count));
-      dispatch(context_, program_, group_count(batch.count, local_size));
-      ++last_dispatch_count_;
-    }
-    memory_barrier(context_);
-  });
+  out.compute_ms = dispatch_batches(context_, program_, batches, [](const Batch& batch) {
+    batch.samples.bind(4);
+    batch.results.bind(5);
+    batch.sample_triangles.bind(6);
+  }, last_dispatch_count_);
 
   out.readback_ms = finish_timed_ms(context_, [&] {
     for (const Batch& batch : batches) {

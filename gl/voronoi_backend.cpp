@@ -168,18 +168,11 @@ DvdOutput GlVoronoiBackend::compute(const DvdInput& in) {
 
   set_dvd_uniforms(program_, in, float32_error_bound(dvd_input_extent(in)));
   shared->bind();
-  const auto local_size = static_cast<GLuint>(program_.local_size()[0]);
-  out.compute_ms = finish_timed_ms(context_, [&] {
-    for (const Batch& batch : batches) {
-      batch.samples.bind(4);
-      batch.results.bind(5);
-      batch.exclude.bind(8);
-      program_.set_uint("sample_count", static_cast<GLuint>(batch.count));
-      dispatch(context_, program_, group_count(batch.count, local_size));
-      ++last_dispatch_count_;
-    }
-    memory_barrier(context_);
-  });
+  out.compute_ms = dispatch_batches(context_, program_, batches, [](const Batch& batch) {
+    batch.samples.bind(4);
+    batch.results.bind(5);
+    batch.exclude.bind(8);
+  }, last_dispatch_count_);
 
   out.readback_ms = finish_timed_ms(context_, [&] {
     for (const Batch& batch : batches) {
