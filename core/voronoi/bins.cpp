@@ -118,6 +118,11 @@ void validate_dvd_input(const DvdInput& in) {
   for (const std::int32_t t : in.bin_tris) {
     if (t < 0 || static_cast<std::size_t>(t) >= tris) fail("bin_tris holds an invalid triangle");
   }
+  for (std::size_t b = 0; b < bins; ++b) {
+    if (!std::is_sorted(in.bin_tris.begin() + in.bin_offsets[b],
+                        in.bin_tris.begin() + in.bin_offsets[b + 1]))
+      fail("a bin's triangles are not in ascending order (call bin_triangles())");
+  }
   const std::int64_t voxel_count = in.grid.voxel_count();
   for (std::size_t k = 0; k < in.voxels.size(); ++k) {
     if (in.voxels[k] < 0 || in.voxels[k] >= voxel_count) fail("voxel id outside the grid");

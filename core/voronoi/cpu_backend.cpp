@@ -86,6 +86,7 @@ class CpuVoronoiBackend final : public DiscreteVoronoiBackend {
     if (voxel_count >= (std::uint64_t{1} << 32))
       throw std::invalid_argument("CpuVoronoiBackend: more than 2^32 - 1 sample voxels");
     const double slack = cpu_prefilter_slack(in.grid);
+    const bool sites_sorted = std::is_sorted(in.tri_site.begin(), in.tri_site.end());
     DvdOutput out;
     out.site1.resize(voxel_count);
     out.site2.resize(voxel_count);
@@ -106,7 +107,7 @@ class CpuVoronoiBackend final : public DiscreteVoronoiBackend {
         if (tris.box_distance_squared(t, q) > c * c) return;
         const double d = std::sqrt(point_triangle_distance(q, tris.prepared[t]).squared_distance);
         if (d < band) top.add(d, in.tri_site[t]);
-      });
+      }, site_triangles(in, sites_sorted, skip));
       const bool has2 = !nearest_only && top.s2 != kNoSite;
       out.site1[k] = top.s1 == kNoSite ? kNoIndex : top.s1;
       out.site2[k] = has2 ? top.s2 : kNoIndex;

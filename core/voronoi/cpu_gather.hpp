@@ -77,16 +77,35 @@ struct GatherTriangles {
   }
 };
 
+/// Triangle ids [lo, hi) that a walk passes over without visiting them (empty: none).
+struct SkippedTriangles {
+  std::int32_t lo = 0, hi = 0;
+};
+
+/// The ids of `site`'s triangles when they are consecutive, which they are when tri_site is
+/// non-decreasing (Stage II lists triangles in object order), else none (`sorted`: whether
+/// in.tri_site is non-decreasing, checked once per call by the caller).
+inline SkippedTriangles site_triangles(const DvdInput& in, bool sorted, std::int32_t site) {
+  if (!sorted || site < 0) return {};
+  const auto lo = std::lower_bound(in.tri_site.begin(), in.tri_site.end(), site);
+  const auto hi = std::upper_bound(lo, in.tri_site.end(), site);
+  return {static_cast<std::int32_t>(lo - in.tri_site.begin()),
+          static_cast<std::int32_t>(hi - in.tri_site.begin())};
+}
+
 /// Calls visit(t) for the triangles listed in the bins of `range`, bins in rings of increasing
 /// Chebyshev distance around the bin of q, each triangle at most once per `stamp` (`seen` holds
 /// the last stamp per triangle; it grows as needed; a stamp must never repeat). Stops before a
 /// ring all of whose points are farther from q than cutoff() (+ the relative slack below), so
 /// every triangle having a point within cutoff() of q is visited, whatever cutoff() returns
-/// while the walk goes on (it may only shrink).
+/// while the walk goes on (it may only shrink). Triangles in `skip` are not visited: each
+/// bin's list is sorted (bins.cpp fills them in triangle order), so they are one run per bin,
+/// found by binary search instead of being stepped over one by one.
 template <typename Cutoff, typename Visit>
 void for_each_nearest_first(const DvdInput& in, const Vec3& q,
                             const BinRange& range, std::vector<std::uint64_t>& seen,
-                            std::uint64_t stamp, const Cutoff& cutoff, const Visit& visit) {
+                            std::uint64_t stamp, const Cutoff& cutoff, const Visit& visit,
+                            SkippedTriangles skip = {}) {
   if (seen.size() < in.tri_site.size()) seen.resize(in.tri_site.size(), 0);
   std::array<std::int32_t, 3> c{};
   std::int32_t rings = 0;
@@ -99,12 +118,23 @@ void for_each_nearest_first(const DvdInput& in, const Vec3& q,
   const double width = in.grid.cell * in.bin_size;
   auto visit_bin = [&](std::int32_t bx, std::int32_t by, std::int32_t bz) {
     const auto b = static_cast<std::size_t>(bin_id(in, bx, by, bz));
-    for (std::int32_t i = in.bin_offsets[b]; i < in.bin_offsets[b + 1]; ++i) {
-      const auto t = static_cast<std::size_t>(in.bin_tris[static_cast<std::size_t>(i)]);
-      if (seen[t] == stamp) continue;
-      seen[t] = stamp;
-      visit(t);
+    const std::int32_t* first = in.bin_tris.data() + in.bin_offsets[b];
+    const std::int32_t* last = in.bin_tris.data() + in.bin_offsets[b + 1];
+    auto visit_run = [&](const std::int32_t* p, const std::int32_t* e) {
+      for (; p != e; ++p) {
+        const auto t = static_cast<std::size_t>(*p);
+        if (seen[t] == stamp) continue;
+        seen[t] = stamp;
+        visit(t);
+      }
+    };
+    if (skip.lo >= skip.hi) {
+      visit_run(first, last);
+      return;
     }
+    const std::int32_t* s0 = std::lower_bound(first, last, skip.lo);
+    visit_run(first, s0);
+    visit_run(std::lower_bound(s0, last, skip.hi), last);
   };
   for (std::int32_t r = 0; r <= rings; ++r) {
     if (r >= 2 && (r - 1) * width > cutoff() * (1 + 0x1p-20)) break;

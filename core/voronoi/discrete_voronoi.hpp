@@ -48,7 +48,8 @@ struct DvdInput {
   /// Triangle binning: bins of bin_size x bin_size x bin_size voxels, bin_dims per axis;
   /// bin b's triangles are bin_tris[bin_offsets[b] .. bin_offsets[b+1]). A triangle is listed
   /// in every bin its bounding box overlaps. To find every triangle within distance r of a
-  /// point, visit all bins overlapping the point's box expanded by r.
+  /// point, visit all bins overlapping the point's box expanded by r. Each bin's list is in
+  /// ascending triangle order (the CPU backends skip an excluded site's run by binary search).
   std::int32_t bin_size = 4;
   std::array<std::int32_t, 3> bin_dims{1, 1, 1};
   std::vector<std::int32_t> bin_offsets;  ///< size bin count + 1
