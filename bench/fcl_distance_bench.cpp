@@ -13,6 +13,7 @@
 // over --fcl-threads threads (default: --threads), one object per task, so that both sides get
 // the same cores. The per-object distances of the two must agree within a relative 1e-6;
 // every disagreement is printed and makes the exit status 1.
+#include "bench/bench_common.hpp"
 #include "core/errors.hpp"
 #include "core/query/inter_distance.hpp"
 #include "io/scene_source.hpp"
@@ -233,41 +234,12 @@ void write_json(const Options& opt, int fcl_threads, const std::vector<FrameTimi
     text += line;
   }
   text += "\n  ]\n}\n";
-  const std::string tmp = opt.json + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f || std::fwrite(text.data(), 1, text.size(), f) != text.size() || std::fclose(f) != 0)
-    throw vproxq::RuntimeError("cannot write " + tmp);
-  if (std::rename(tmp.c_str(), opt.json.c_str()) != 0)
-    throw vproxq::RuntimeError("cannot rename " + tmp + " to " + opt.json);
-}
-
-/// Parses --frames into [first, last) within [0, count). Throws UsageError.
-std::pair<std::size_t, std::size_t> frame_range(const std::string& spec, std::size_t count) {
-  if (spec.empty()) return {0, count};
-  auto number = [&](const std::string& s, std::size_t fallback) -> std::size_t {
-    if (s.empty()) return fallback;
-    if (s.find_first_not_of("0123456789") != std::string::npos)
-      throw vproxq::UsageError("--frames: '" + spec + "' is not A:B, A: , :B or A");
-    return static_cast<std::size_t>(std::stoull(s));
-  };
-  const auto colon = spec.find(':');
-  std::size_t first = 0, last = 0;
-  if (colon == std::string::npos) {
-    first = number(spec, 0);
-    last = first + 1;
-  } else {
-    first = number(spec.substr(0, colon), 0);
-    last = number(spec.substr(colon + 1), count);
-  }
-  if (first >= last || last > count)
-    throw vproxq::UsageError("--frames " + spec + ": the scene has frames 0.." +
-                             std::to_string(count - 1) + " (A:B means A..B-1)");
-  return {first, last};
+  vproxq::bench::write_file_atomically(opt.json, text);
 }
 
 int run(const Options& opt) {
   const vproxq::SceneSource scene = vproxq::SceneSource::open(opt.scene);
-  const auto [first, last] = frame_range(opt.frames, scene.frame_count());
+  const auto [first, last] = vproxq::bench::frame_range(opt.frames, scene.frame_count());
   const int fcl_threads = opt.fcl_threads.value_or(opt.threads);
 
   std::printf("scene %s (%s): frames %zu..%zu of %zu; vproxq threads %d, FCL %s threads %d; "
@@ -369,22 +341,5 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--json", opt.json,
                  "also write the per-frame timings to this JSON file (read by vproxq-report)");
-  try {
-    app.parse(argc, argv);
-    return run(opt);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : vproxq::exit_code::kUsage;
-  } catch (const vproxq::UsageError& e) {
-    std::cerr << "vproxq-bench-fcl: error: " << e.what() << "\n";
-    return vproxq::exit_code::kUsage;
-  } catch (const vproxq::InputError& e) {
-    std::cerr << "vproxq-bench-fcl: error: " << e.what() << "\n";
-    return vproxq::exit_code::kInput;
-  } catch (const vproxq::RuntimeError& e) {
-    std::cerr << "vproxq-bench-fcl: error: " << e.what() << "\n";
-    return vproxq::exit_code::kRuntime;
-  } catch (const std::exception& e) {
-    std::cerr << "vproxq-bench-fcl: error: " << e.what() << "\n";
-    return vproxq::exit_code::kRuntime;
-  }
+  return vproxq::bench::guarded_main("vproxq-bench-fcl", app, argc, argv, [&] { return run(opt); });
 }

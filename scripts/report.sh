@@ -30,6 +30,8 @@
 #   THREADS      2                   vproxq --threads, FCL threads
 #   FCL          1                   0: skip FCL
 #   REPEAT       1                   FCL bench: runs per frame, fastest kept
+#   PNS          1                   0: skip vproxq-bench-pns (exact tests against their floor
+#                                    and the paper's fixed-bound PNS, same frames as RANGE)
 #   GRID_SCENES  funnel              scenes of the grid sweep (the paper's figure 14 used its
 #                                    200-object scene); "" skips the sweep
 #   GRIDS        "32 48 64 96 128 192 256"   --grid values of the sweep (--voronoi=cpu)
@@ -47,6 +49,7 @@ seed=${SEED:-1}
 range=${RANGE:-}
 threads=${THREADS:-2}
 fcl=${FCL:-1}
+pns=${PNS:-1}
 repeat=${REPEAT:-1}
 grid_scenes=${GRID_SCENES-funnel}
 grids=${GRIDS:-32 48 64 96 128 192 256}
@@ -58,11 +61,13 @@ bash scripts/setup.sh --bench --no-build
 
 cmake -S . -B build-bench -DCMAKE_BUILD_TYPE=Release -DVPROXQ_BUILD_BENCH=ON \
   -DVPROXQ_BUILD_TESTS=OFF
-cmake --build build-bench --target vproxq vproxq-gen vproxq-bench-fcl vproxq-report -j"$jobs"
+cmake --build build-bench --target vproxq vproxq-gen vproxq-bench-fcl vproxq-bench-pns \
+  vproxq-report -j"$jobs"
 
 gen=build-bench/sample_scenes/vproxq-gen
 vproxq=build-bench/app/vproxq
 fcl_bench=build-bench/bench/vproxq-bench-fcl
+pns_bench=build-bench/bench/vproxq-bench-pns
 report=build-bench/bench/report/vproxq-report
 
 # The requested queries that this vproxq implements (it says "not implemented" otherwise).
@@ -140,6 +145,14 @@ for scene in $scenes; do
         echo "    FCL and vproxq disagree on some distances: see $out/runs/$scene/fcl.txt"
       fi
     fi
+  fi
+
+  if [ "$pns" = 1 ]; then
+    echo "  vproxq-bench-pns (exact tests, floors, fixed-bound PNS)"
+    mkdir -p "$out/runs/$scene"
+    "$pns_bench" "$dir/scene.json" --threads "$threads" ${range:+--frames "$range"} \
+      --json "$out/runs/$scene/pns.json" >"$out/runs/$scene/pns.txt" 2>&1 ||
+      echo "    vproxq-bench-pns failed: $(tail -n 2 "$out/runs/$scene/pns.txt" | tr '\n' ' ')"
   fi
 
   for g in $grids; do

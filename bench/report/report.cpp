@@ -7,6 +7,7 @@
 //   <scene>/off/results.json, cpu/results.json, gpu/results.json   vproxq -o, per Stage II mode
 //   <scene>/grid-<N>/results.json                                    vproxq --voronoi=cpu --grid N
 //   <scene>/fcl.json                                                 vproxq-bench-fcl --json
+//   <scene>/pns.json (optional)                                      vproxq-bench-pns --json
 //   <scene>/<run>/error.txt or <scene>/fcl-error.txt                 why a run failed ("n/a")
 // Output in --out: report.md (the tables), results.csv (every per-frame number of every run),
 // summary.csv (the per-run averages behind the tables), fig13.dat/.gp and fig14.dat/.gp (gnuplot
@@ -106,6 +107,7 @@ struct Run {
 struct Scene {
   std::string name;
   std::map<std::string, Run> runs;
+  json pns;  ///< vproxq-bench-pns --json, or null where it did not run
 };
 
 std::string slurp(const fs::path& p) {
@@ -248,6 +250,11 @@ std::vector<Scene> read_scenes(const fs::path& runs_dir) {
         s.runs[run] = read_vproxq_run(run, r.path());
     }
     s.runs["fcl"] = read_fcl_run(e.path());
+    if (fs::exists(e.path() / "pns.json")) {
+      std::ifstream in(e.path() / "pns.json");
+      s.pns = json::parse(in, nullptr, /*allow_exceptions=*/false);
+      if (s.pns.is_discarded()) s.pns = nullptr;
+    }
     scenes.push_back(std::move(s));
   }
   auto rank = [](const std::string& n) {
@@ -551,6 +558,37 @@ std::string report_markdown(const std::vector<Scene>& scenes, const std::string&
            << (mode == "off" ? (v ? "1" : kNotRun) : reduction_cell(off, m, q));
       }
       md << " |\n";
+    }
+  }
+
+  if (std::any_of(scenes.begin(), scenes.end(), [](const Scene& s) { return s.pns.is_object(); })) {
+    md << "\n## Exact tests against their floor and the paper's PNS (`vproxq-bench-pns`)\n\n";
+    md << "Sums over the frames `vproxq-bench-pns` ran (the same frames as the runs above, "
+          "Stage II on the CPU at the default grid). *tests*: Stage III's exact tests, whose "
+          "bound shrinks to the best distance found so far; *floor*: the pairs whose boxes (and, "
+          "with Stage II, both triangles' D_l) lie within the final answer, which no search "
+          "that culls by boxes and D_l can skip; *fixed*: the paper's feature-level PNS with "
+          "fixed bounds (Stage I's U_i or the 2-ring bound without Stage II, D_u and D_l with "
+          "it), what the paper's figure 13 counts. Reduction: off / cpu.\n\n";
+    md << "| Benchmark | query | frames | tests off | tests cpu | reduction | floor off | "
+          "floor cpu | reduction | fixed off | fixed cpu | reduction |\n"
+          "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    for (const Scene& s : scenes) {
+      if (!s.pns.is_object() || !s.pns.contains("frames") || !s.pns["frames"].is_array()) continue;
+      const json& frames = s.pns["frames"];
+      for (const char* query : {"inter", "intra"}) {
+        std::map<std::string, double> sum;
+        for (const json& f : frames)
+          for (const char* key : {"tests_off", "tests_cpu", "floor_off", "floor_cpu", "fixed_off", "fixed_cpu"})
+            sum[key] += number(object_at(f, query), key);
+        auto pair_cells = [&](const std::string& what) {
+          const double off = sum[what + "_off"], cpu = sum[what + "_cpu"];
+          return count(off) + " | " + count(cpu) + " | " + (cpu > 0 ? fixed(off / cpu, 2) : "n/a");
+        };
+        md << "| " << s.name << " | " << query << " | " << frames.size() << " | "
+           << pair_cells("tests") << " | " << pair_cells("floor") << " | " << pair_cells("fixed")
+           << " |\n";
+      }
     }
   }
 
