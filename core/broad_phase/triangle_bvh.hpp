@@ -4,6 +4,9 @@
 // a query box (the paper's expanded-AABB overlap test, without scanning every triangle).
 #include "core/broad_phase/aabb.hpp"
 
+#include <algorithm>
+#include <functional>
+#include <limits>
 #include <vector>
 
 namespace vproxq {
@@ -21,6 +24,8 @@ class TriangleBvh {
   void query(const AABB& query, const Bound& bound, const Visit& visit) const;
 
   bool empty() const { return nodes_.empty(); }
+
+  class BestFirst;
 
  private:
   static constexpr int kLeafSize = 4;
@@ -64,6 +69,92 @@ void TriangleBvh::query(const AABB& q, const Bound& bound, const Visit& visit) c
     } else {
       stack[top++] = l;
       stack[top++] = r;
+    }
+  }
+}
+
+/// Best-first search of query boxes ("probes") against triangle hierarchies: run() visits
+/// (probe, triangle) pairs in nondecreasing squared box distance over all probes added so far
+/// (ties: by probe, then by the triangle's place in its hierarchy, so the order is
+/// deterministic) while that distance is within bound(), which is re-read before each step
+/// (visit may lower it). Once the bound has come down to an answer d, no pair whose boxes are
+/// farther apart than d is visited. Probes may be added between runs: a caller that adds them
+/// in nondecreasing order of a lower bound L on their boxes' distances and runs up to L before
+/// each addition keeps the global order. Reusable: clear() keeps the allocations.
+class TriangleBvh::BestFirst {
+ public:
+  void clear() {
+    probes_.clear();
+    heap_.clear();
+  }
+  /// Adds a probe (query box `box` into `bvh`) unless its root is farther than `bound`;
+  /// returns its index either way (probes are numbered in the order added).
+  std::size_t add(const TriangleBvh& bvh, const AABB& box, double bound) {
+    const std::size_t p = probes_.size();
+    probes_.push_back({&bvh, box});
+    if (!bvh.nodes_.empty()) {
+      const double d2 = box_distance_squared(box, bvh.nodes_[0].box);
+      if (d2 <= bound * bound) push({d2, static_cast<std::int32_t>(p), 0});
+    }
+    return p;
+  }
+  std::size_t size() const { return probes_.size(); }
+  /// Visits pairs as described above, stopping at the first entry beyond bound() or beyond
+  /// `until_d2` (squared); visit(probe, triangle, squared box distance). Entries of a probe
+  /// for which keep(probe) has become false are dropped unexpanded (e.g. a probe that can no
+  /// longer improve the answer).
+  template <typename Bound, typename Keep, typename Visit>
+  void run(const Bound& bound, const Keep& keep, const Visit& visit,
+           double until_d2 = std::numeric_limits<double>::infinity());
+
+ private:
+  struct Probe {
+    const TriangleBvh* bvh;
+    AABB box;
+  };
+  struct Entry {
+    double d2;
+    std::int32_t probe;
+    std::int32_t item;  ///< >= 0: node index; < 0: -(leaf slot + 1), a triangle
+    bool operator>(const Entry& o) const {
+      return d2 != o.d2 ? d2 > o.d2 : probe != o.probe ? probe > o.probe : item > o.item;
+    }
+  };
+  void push(const Entry& e) {
+    heap_.push_back(e);
+    std::push_heap(heap_.begin(), heap_.end(), std::greater<Entry>());
+  }
+  std::vector<Probe> probes_;
+  std::vector<Entry> heap_;
+};
+
+template <typename Bound, typename Keep, typename Visit>
+void TriangleBvh::BestFirst::run(const Bound& bound, const Keep& keep, const Visit& visit,
+                                 double until_d2) {
+  while (!heap_.empty()) {
+    const double b = bound();
+    const Entry e = heap_.front();
+    if (e.d2 > b * b || e.d2 > until_d2) return;
+    std::pop_heap(heap_.begin(), heap_.end(), std::greater<Entry>());
+    heap_.pop_back();
+    if (!keep(static_cast<std::size_t>(e.probe))) continue;
+    const Probe& probe = probes_[static_cast<std::size_t>(e.probe)];
+    const TriangleBvh& bvh = *probe.bvh;
+    if (e.item < 0) {
+      visit(static_cast<std::size_t>(e.probe), bvh.order_[static_cast<std::size_t>(-e.item - 1)], e.d2);
+      continue;
+    }
+    const Node& node = bvh.nodes_[static_cast<std::size_t>(e.item)];
+    auto offer = [&](const AABB& box, std::int32_t item) {
+      const double d2 = box_distance_squared(probe.box, box);
+      if (d2 <= b * b) push({d2, e.probe, item});
+    };
+    if (node.count > 0) {
+      for (std::int32_t k = node.first; k < node.first + node.count; ++k)
+        offer(bvh.leaf_boxes_[static_cast<std::size_t>(k)], -k - 1);
+    } else {
+      offer(bvh.nodes_[static_cast<std::size_t>(node.first)].box, node.first);
+      offer(bvh.nodes_[static_cast<std::size_t>(node.first + 1)].box, node.first + 1);
     }
   }
 }

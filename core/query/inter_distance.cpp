@@ -72,41 +72,61 @@ InterObjectDistance to_result(Index i, const Best& best) {
   return out;
 }
 
-/// Searches the triangle pairs of objects i and j within the current bound, updating `best`:
-/// triangles of i near j's box (nearest first) each query j's triangle BVH with their box
-/// expanded by the bound (paper 5.2.1's expanded-AABB overlap test), and the exact test runs
-/// on every pair that passes. `u` is D_u(O_i) from Stage I or II.
-void search_pair(const Frame& frame, const FrameBoxes& boxes, const TriangleBvh& bvh_j, Index i,
-                 Index j, double u, double slack, const VoronoiBounds* voronoi, Best& best,
-                 std::vector<std::pair<double, Index>>& self_tris, DistanceCounters& counters) {
+/// Scratch space of one search, reused by a thread from object to object.
+struct SearchScratch {
+  TriangleBvh::BestFirst search;
+  std::vector<std::pair<Index, Index>> probe_pair;  ///< (other object j, own triangle) per probe
+};
+
+/// Searches object i's PNS for its nearest object, updating `best`. Feature-level culling
+/// (paper 5.2.1): each triangle of i within the bound of an object j's box, and with Stage II
+/// whose lower bound D_l does not exceed it, is a probe into j's triangle BVH (the
+/// expanded-AABB overlap test). All probes are searched together, best first: triangle pairs
+/// are tested in nondecreasing box distance, so no pair whose boxes are farther apart than the
+/// answer is ever tested. Objects join in PNS order (by box distance, a lower bound on their
+/// probes' distances), each once the search has run up to its box distance. A pair (f, g) at
+/// distance d <= bound has D_l(f) <= d and D_l(g) <= d (each is at most d from some other
+/// object), so the D_l cuts lose nothing. `u` is D_u(O_i) from Stage I or II.
+void search_object(const Frame& frame, const FrameBoxes& boxes, const std::vector<TriangleBvh>& bvhs,
+                   const std::vector<Index>& pns, Index i, double u, double slack,
+                   const VoronoiBounds* voronoi, Best& best, SearchScratch& scratch,
+                   DistanceCounters& counters) {
+  const auto ui = static_cast<size_t>(i);
+  const auto& tb_i = boxes.triangles[ui];
+  const double* low_i = voronoi ? voronoi->triangle_lower[ui].data() : nullptr;
   auto bound = [&] { return std::min(u, best.distance) + slack; };
-  const auto& tb_i = boxes.triangles[static_cast<size_t>(i)];
-  const AABB& box_j = boxes.objects[static_cast<size_t>(j)];
-  // Feature-level culling: triangles of i near j's box and, with Stage II, whose lower bound
-  // D_l does not exceed the bound. A pair (f, g) at distance d <= bound has D_l(f) <= d and
-  // D_l(g) <= d (each is at most d from some other object), so no answer is culled.
-  const double* low_i = voronoi ? voronoi->triangle_lower[static_cast<size_t>(i)].data() : nullptr;
-  const double* low_j = voronoi ? voronoi->triangle_lower[static_cast<size_t>(j)].data() : nullptr;
-  const double b0 = bound();
-  self_tris.clear();
-  for (Index t = 0; t < static_cast<Index>(tb_i.size()); ++t) {
-    if (low_i && low_i[t] > b0) continue;
-    const double d2 = box_distance_squared(tb_i[static_cast<size_t>(t)], box_j);
-    if (d2 <= b0 * b0) self_tris.emplace_back(d2, t);
-  }
-  counters.feature_pns += self_tris.size();
-  std::sort(self_tris.begin(), self_tris.end());
-  for (const auto& [d2, ts] : self_tris) {
+  // A probe stays useful while its triangle may still be part of a better pair.
+  auto keep = [&](std::size_t p) {
+    const auto [j, ts] = scratch.probe_pair[p];
+    return !(low_i && low_i[ts] > bound()) && !best.contact_prunes(j, ts);
+  };
+  auto visit = [&](std::size_t p, Index to, double) {
+    const auto [j, ts] = scratch.probe_pair[p];
+    if (voronoi && voronoi->triangle_lower[static_cast<size_t>(j)][static_cast<size_t>(to)] > bound()) return;
+    if (best.contact_prunes(j, ts, to)) return;
+    consider(frame, i, ts, j, to, best);
+    ++counters.exact_tests;
+  };
+  scratch.search.clear();
+  scratch.probe_pair.clear();
+  for (Index j : pns) {
+    const AABB& box_j = boxes.objects[static_cast<size_t>(j)];
+    const double dj2 = box_distance_squared(boxes.objects[ui], box_j);
+    scratch.search.run(bound, keep, visit, dj2);
     const double b = bound();
-    if (d2 > b * b) break;
-    if (best.contact_prunes(j, ts)) continue;
-    bvh_j.query(tb_i[static_cast<size_t>(ts)], bound, [&](Index to, double) {
-      if (low_j && low_j[to] > bound()) return;
-      if (best.contact_prunes(j, ts, to)) return;
-      consider(frame, i, ts, j, to, best);
-      ++counters.exact_tests;
-    });
+    if (dj2 > b * b) break;  // PNS: sorted by box distance
+    if (best.contact_prunes(j)) continue;
+    ++counters.object_pns_pairs;
+    for (Index t = 0; t < static_cast<Index>(tb_i.size()); ++t) {
+      if ((low_i && low_i[t] > b) || best.contact_prunes(j, t)) continue;
+      const AABB& box_t = tb_i[static_cast<size_t>(t)];
+      if (box_distance_squared(box_t, box_j) > b * b) continue;
+      scratch.search.add(bvhs[static_cast<size_t>(j)], box_t, b);
+      scratch.probe_pair.emplace_back(j, t);
+      ++counters.feature_pns;
+    }
   }
+  scratch.search.run(bound, keep, visit);
 }
 
 }  // namespace
@@ -137,19 +157,11 @@ InterDistanceOutput inter_object_distance(const Frame& frame, const FrameBoxes& 
   parallel_for(n, threads, [&](size_t ui) {
     const Index i = static_cast<Index>(ui);
     Best best;
-    std::vector<std::pair<double, Index>> self_tris;
+    thread_local SearchScratch scratch;
     // D_u(O_i): Stage II's bound when it ran, else Stage I's.
     const double u = opts.voronoi ? opts.voronoi->object_upper[ui] : stage1.upper_bound[ui];
-    for (Index j : stage1.pns[ui]) {
-      const double bound = std::min(u, best.distance) + slack;
-      if (box_distance_squared(boxes.objects[ui], boxes.objects[static_cast<size_t>(j)]) >
-          bound * bound)
-        break;  // PNS is sorted by box distance
-      if (best.contact_prunes(j)) continue;
-      ++counters[ui].object_pns_pairs;
-      search_pair(frame, boxes, bvhs[static_cast<size_t>(j)], i, j, u, slack, opts.voronoi, best,
-                  self_tris, counters[ui]);
-    }
+    search_object(frame, boxes, bvhs, stage1.pns[ui], i, u, slack, opts.voronoi, best, scratch,
+                  counters[ui]);
     out.per_object[ui] = to_result(i, best);
   });
   for (const auto& c : counters) {
