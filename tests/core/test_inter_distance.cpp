@@ -1,9 +1,14 @@
 // Inter-object N-body distance: Stage I + Stage III against the all-pairs brute force.
 #include "core/broad_phase/object_broad_phase.hpp"
+#include "core/broad_phase/triangle_bvh.hpp"
 #include "core/query/inter_distance.hpp"
 #include "support/random_scene.hpp"
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+#include <tuple>
 
 namespace vproxq {
 namespace {
@@ -101,6 +106,52 @@ TEST(InterDistance, SingleObjectAndEmptyObjectsHaveNoNearest) {
   expect_same(got, inter_object_distance_brute_force(one), "with empty object");
   EXPECT_FALSE(got.per_object[1].has_nearest());
   EXPECT_EQ(got.per_object[0].nearest_object, 2);
+}
+
+TEST(TriangleBvhBestFirst, VisitsExactlyThePairsWithinTheBoundInNondecreasingOrder) {
+  // Two random frames' objects as hierarchies, a few probes into each, and a fixed bound: the
+  // search must visit every (probe, triangle) whose boxes are within the bound, once, in
+  // nondecreasing box distance, and nothing else; probes added later in lower-bound order
+  // (after a run up to that lower bound) keep the order.
+  const Frame frame = make_random_frame(7, 4, 1.2, 1);
+  const FrameBoxes boxes = FrameBoxes::compute(frame, 1);
+  std::vector<TriangleBvh> bvhs(frame.objects.size());
+  for (size_t i = 0; i < bvhs.size(); ++i) bvhs[i].build(boxes.triangles[i]);
+  struct P {
+    size_t object;
+    AABB box;
+  };
+  std::vector<P> probes;
+  for (size_t i = 0; i < bvhs.size(); ++i)
+    for (size_t t = 0; t < boxes.triangles[0].size(); t += 7) probes.push_back({i, boxes.triangles[0][t]});
+  std::sort(probes.begin(), probes.end(), [&](const P& a, const P& b) {
+    return box_distance_squared(a.box, boxes.objects[a.object]) < box_distance_squared(b.box, boxes.objects[b.object]);
+  });
+  for (double bound : {0.0, 0.05, 0.3, 10.0}) {
+    SCOPED_TRACE("bound " + std::to_string(bound));
+    std::multiset<std::pair<size_t, Index>> expected;
+    for (size_t p = 0; p < probes.size(); ++p)
+      for (Index t = 0; t < static_cast<Index>(boxes.triangles[probes[p].object].size()); ++t)
+        if (box_distance_squared(probes[p].box, boxes.triangles[probes[p].object][static_cast<size_t>(t)]) <= bound * bound)
+          expected.insert({p, t});
+    TriangleBvh::BestFirst search;
+    std::multiset<std::pair<size_t, Index>> got;
+    double last = -1;
+    auto b = [&] { return bound; };
+    auto keep = [](size_t) { return true; };
+    auto visit = [&](size_t p, Index t, double d2) {
+      EXPECT_GE(d2, last);
+      EXPECT_EQ(d2, box_distance_squared(probes[p].box, boxes.triangles[probes[p].object][static_cast<size_t>(t)]));
+      last = d2;
+      got.insert({p, t});
+    };
+    for (const P& pr : probes) {
+      search.run(b, keep, visit, box_distance_squared(pr.box, boxes.objects[pr.object]));
+      search.add(bvhs[pr.object], pr.box, bound);
+    }
+    search.run(b, keep, visit);
+    EXPECT_EQ(got, expected);
+  }
 }
 
 TEST(ObjectBroadPhase, BoundsAndPnsAreConservative) {
