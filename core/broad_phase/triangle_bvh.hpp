@@ -73,14 +73,17 @@ void TriangleBvh::query(const AABB& q, const Bound& bound, const Visit& visit) c
   }
 }
 
-/// Best-first search of query boxes ("probes") against triangle hierarchies: run() visits
-/// (probe, triangle) pairs in nondecreasing squared box distance over all probes added so far
-/// (ties: by probe, then by the triangle's place in its hierarchy, so the order is
-/// deterministic) while that distance is within bound(), which is re-read before each step
-/// (visit may lower it). Once the bound has come down to an answer d, no pair whose boxes are
-/// farther apart than d is visited. Probes may be added between runs: a caller that adds them
-/// in nondecreasing order of a lower bound L on their boxes' distances and runs up to L before
-/// each addition keeps the global order. Reusable: clear() keeps the allocations.
+/// Best-first search of query boxes ("probes") against triangle hierarchies: run() expands
+/// (probe, node) entries in nondecreasing squared box distance over all probes added so far,
+/// while that distance is within bound(), which is re-read before each step (visit may lower
+/// it). A leaf's triangles are visited when the leaf comes up, each whose box is within the
+/// bound at that moment; so once the bound has come down to an answer d, no leaf farther than
+/// d is opened and no pair whose boxes are farther apart than d is visited. (Visiting a leaf's
+/// triangles at once, rather than queueing each, halves the queue's traffic at the cost of a
+/// few tests beyond the strict order.) Probes may be added between runs: a caller that adds
+/// them in nondecreasing order of a lower bound L on their boxes' distances and runs up to L
+/// before each addition keeps the global order. Equal distances are taken by probe number, then
+/// node, so the search is deterministic. clear() keeps the allocations.
 class TriangleBvh::BestFirst {
  public:
   void clear() {
@@ -115,9 +118,11 @@ class TriangleBvh::BestFirst {
   struct Entry {
     double d2;
     std::int32_t probe;
-    std::int32_t item;  ///< >= 0: node index; < 0: -(leaf slot + 1), a triangle
+    std::int32_t node;
+    /// Ties by probe (a caller numbering its probes in a useful order, e.g. by triangle id
+    /// for a tie-break on ids, gets that order among equal distances), then by node.
     bool operator>(const Entry& o) const {
-      return d2 != o.d2 ? d2 > o.d2 : probe != o.probe ? probe > o.probe : item > o.item;
+      return d2 != o.d2 ? d2 > o.d2 : probe != o.probe ? probe > o.probe : node > o.node;
     }
   };
   void push(const Entry& e) {
@@ -140,22 +145,21 @@ void TriangleBvh::BestFirst::run(const Bound& bound, const Keep& keep, const Vis
     if (!keep(static_cast<std::size_t>(e.probe))) continue;
     const Probe& probe = probes_[static_cast<std::size_t>(e.probe)];
     const TriangleBvh& bvh = *probe.bvh;
-    if (e.item < 0) {
-      visit(static_cast<std::size_t>(e.probe), bvh.order_[static_cast<std::size_t>(-e.item - 1)], e.d2);
+    const Node& node = bvh.nodes_[static_cast<std::size_t>(e.node)];
+    if (node.count > 0) {
+      for (std::int32_t k = node.first; k < node.first + node.count; ++k) {
+        const double d2 = box_distance_squared(probe.box, bvh.leaf_boxes_[static_cast<std::size_t>(k)]);
+        const double bk = bound();
+        if (d2 <= bk * bk) visit(static_cast<std::size_t>(e.probe), bvh.order_[static_cast<std::size_t>(k)], d2);
+      }
       continue;
     }
-    const Node& node = bvh.nodes_[static_cast<std::size_t>(e.item)];
-    auto offer = [&](const AABB& box, std::int32_t item) {
+    auto offer = [&](const AABB& box, std::int32_t child) {
       const double d2 = box_distance_squared(probe.box, box);
-      if (d2 <= b * b) push({d2, e.probe, item});
+      if (d2 <= b * b) push({d2, e.probe, child});
     };
-    if (node.count > 0) {
-      for (std::int32_t k = node.first; k < node.first + node.count; ++k)
-        offer(bvh.leaf_boxes_[static_cast<std::size_t>(k)], -k - 1);
-    } else {
-      offer(bvh.nodes_[static_cast<std::size_t>(node.first)].box, node.first);
-      offer(bvh.nodes_[static_cast<std::size_t>(node.first + 1)].box, node.first + 1);
-    }
+    offer(bvh.nodes_[static_cast<std::size_t>(node.first)].box, node.first);
+    offer(bvh.nodes_[static_cast<std::size_t>(node.first + 1)].box, node.first + 1);
   }
 }
 
