@@ -34,6 +34,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <cstdio>
@@ -50,6 +51,15 @@ struct Counts {
   Count tests_off = 0, tests_cpu = 0;
   Count floor_off = 0, floor_cpu = 0;
   Count fixed_off = 0, fixed_cpu = 0;
+
+  std::array<Count*, 6> fields() {
+    return {&tests_off, &tests_cpu, &floor_off, &floor_cpu, &fixed_off, &fixed_cpu};
+  }
+  Counts& operator+=(Counts c) {
+    const auto mine = fields(), theirs = c.fields();
+    for (std::size_t k = 0; k < mine.size(); ++k) *mine[k] += *theirs[k];
+    return *this;
+  }
 };
 
 struct FrameRow {
@@ -243,14 +253,6 @@ int run(const Options& opt) {
               "ratio");
   std::vector<FrameRow> rows;
   Counts sum_inter, sum_intra;
-  auto add = [](Counts& s, const Counts& c) {
-    s.tests_off += c.tests_off;
-    s.tests_cpu += c.tests_cpu;
-    s.floor_off += c.floor_off;
-    s.floor_cpu += c.floor_cpu;
-    s.fixed_off += c.fixed_off;
-    s.fixed_cpu += c.fixed_cpu;
-  };
   bool identical = true;
   for (std::size_t k = first; k < last; ++k) {
     const FrameRow row = measure(scene.load_frame(k), k, opt);
@@ -258,8 +260,8 @@ int run(const Options& opt) {
                 row.identical ? "" : ": OFF AND CPU ANSWERS DIFFER");
     print_row("inter", row.inter);
     print_row("intra", row.intra);
-    add(sum_inter, row.inter);
-    add(sum_intra, row.intra);
+    sum_inter += row.inter;
+    sum_intra += row.intra;
     identical = identical && row.identical;
     rows.push_back(row);
   }
