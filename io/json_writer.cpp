@@ -16,20 +16,20 @@ using Json = nlohmann::ordered_json;
 
 Json point_json(const Vec3& p) { return Json::array({p.x(), p.y(), p.z()}); }
 
+/// The distance, triangle pair and closest points of an answer, or nulls where there is none
+/// (key order as in DESIGN.md).
+void put_pair(Json& r, bool has, double distance, const std::array<Index, 2>& triangles,
+              const std::array<Vec3, 2>& points) {
+  r["distance"] = has ? Json(distance) : Json(nullptr);
+  r["triangles"] = has ? Json::array({triangles[0], triangles[1]}) : Json(nullptr);
+  r["points"] = has ? Json::array({point_json(points[0]), point_json(points[1])}) : Json(nullptr);
+}
+
 Json inter_json(const InterObjectDistance& d) {
   Json r;
   r["object"] = d.object;
-  if (d.has_nearest()) {
-    r["nearest_object"] = d.nearest_object;
-    r["distance"] = d.distance;
-    r["triangles"] = Json::array({d.triangles[0], d.triangles[1]});
-    r["points"] = Json::array({point_json(d.points[0]), point_json(d.points[1])});
-  } else {
-    r["nearest_object"] = nullptr;
-    r["distance"] = nullptr;
-    r["triangles"] = nullptr;
-    r["points"] = nullptr;
-  }
+  r["nearest_object"] = d.has_nearest() ? Json(d.nearest_object) : Json(nullptr);
+  put_pair(r, d.has_nearest(), d.distance, d.triangles, d.points);
   return r;
 }
 
@@ -50,15 +50,8 @@ Json pd_json(const PenetrationDepth& p) {
 Json intra_json(const IntraObjectDistance& d) {
   Json r;
   r["object"] = d.object;
-  if (d.has_pair()) {
-    r["distance"] = d.distance;
-    r["triangles"] = Json::array({d.triangles[0], d.triangles[1]});
-    r["points"] = Json::array({point_json(d.points[0]), point_json(d.points[1])});
-  } else {  // no two triangles of the object are non-adjacent
-    r["distance"] = nullptr;
-    r["triangles"] = nullptr;
-    r["points"] = nullptr;
-  }
+  // No pair: no two triangles of the object are non-adjacent.
+  put_pair(r, d.has_pair(), d.distance, d.triangles, d.points);
   return r;
 }
 

@@ -209,25 +209,9 @@ class BinaryCursor {
   std::size_t remaining() const { return static_cast<std::size_t>(end_ - p_); }
 
   double real(PlyType t) {
-    switch (t) {
-      case PlyType::Int8:
-        return get<std::int8_t>();
-      case PlyType::UInt8:
-        return get<std::uint8_t>();
-      case PlyType::Int16:
-        return get<std::int16_t>();
-      case PlyType::UInt16:
-        return get<std::uint16_t>();
-      case PlyType::Int32:
-        return get<std::int32_t>();
-      case PlyType::UInt32:
-        return get<std::uint32_t>();
-      case PlyType::Float32:
-        return static_cast<double>(get<float>());
-      case PlyType::Float64:
-        return get<double>();
-    }
-    return 0;
+    if (t == PlyType::Float32) return static_cast<double>(get<float>());
+    if (t == PlyType::Float64) return get<double>();
+    return static_cast<double>(integer(t));  // every integer type fits a double exactly
   }
   long long integer(PlyType t) {
     switch (t) {

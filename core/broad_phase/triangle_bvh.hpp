@@ -101,7 +101,6 @@ class TriangleBvh::BestFirst {
     }
     return p;
   }
-  std::size_t size() const { return probes_.size(); }
   /// Visits pairs as described above, stopping at the first entry beyond bound() or beyond
   /// `until_d2` (squared); visit(probe, triangle, squared box distance). Entries of a probe
   /// for which keep(probe) has become false are dropped unexpanded (e.g. a probe that can no
