@@ -4,6 +4,7 @@
 #include "app/config.hpp"
 #include "core/errors.hpp"
 #include "io/result_diff.hpp"
+#include "io/scene_source.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -150,7 +151,7 @@ int cli_main(int argc, char** argv) {
       ->required();
   app.add_option("--queries", config.queries,
                  "comma-separated queries to run (default: the scene's \"queries\", else "
-                 "distance). Valid: distance, ccd")
+                 "distance). Valid: " + query_names_list())
       ->delimiter(',');
   app.add_option("-o,--output", config.output_dir,
                  "write OUT/results.json and OUT/results.h5 (default: print a summary)");

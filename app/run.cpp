@@ -26,29 +26,18 @@
 namespace vproxq {
 namespace {
 
-/// Queries in canonical order.
-constexpr const char* kQueries[] = {"distance", "ccd", "pd"};
-
-std::string valid_queries() {
-  std::string s;
-  for (const char* q : kQueries) s += (s.empty() ? "" : ", ") + std::string(q);
-  return s;
-}
-
 /// Checks the requested queries and returns them in canonical order, without duplicates.
 std::vector<std::string> canonical_queries(const std::vector<std::string>& requested,
                                            const char* origin) {
   for (const auto& r : requested) {
-    const auto* q = std::find_if(std::begin(kQueries), std::end(kQueries),
-                                 [&](const char* k) { return r == k; });
-    if (q == std::end(kQueries))
+    if (std::find(kQueryNames.begin(), kQueryNames.end(), r) == kQueryNames.end())
       throw UsageError(std::string(origin) + ": unknown query '" + r +
-                       "'; valid queries: " + valid_queries());
+                       "'; valid queries: " + query_names_list());
   }
   std::vector<std::string> out;
-  for (const char* q : kQueries)
+  for (const auto q : kQueryNames)
     if (std::find(requested.begin(), requested.end(), q) != requested.end()) out.emplace_back(q);
-  if (out.empty()) throw UsageError(std::string(origin) + ": no query given; valid queries: " + valid_queries());
+  if (out.empty()) throw UsageError(std::string(origin) + ": no query given; valid queries: " + query_names_list());
   return out;
 }
 

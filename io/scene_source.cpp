@@ -23,9 +23,6 @@ using nlohmann::json;
 
 namespace {
 
-/// Query names scene.json "queries" may list (DESIGN.md, table of queries).
-constexpr std::array<std::string_view, 3> kQueryNames = {"distance", "ccd", "pd"};
-
 /// One sequence of frame files: the scene's (one file per frame, all objects), or one
 /// object's (per-object sequences).
 struct Sequence {
@@ -276,6 +273,12 @@ std::vector<MeshGroup> split_groups(std::vector<MeshGroup> groups, ObjectSplit s
 
 }  // namespace
 
+std::string query_names_list() {
+  std::string s;
+  for (const auto q : kQueryNames) s += (s.empty() ? "" : ", ") + std::string(q);
+  return s;
+}
+
 struct SceneSource::Impl {
   fs::path path;
   std::string name;
@@ -374,7 +377,9 @@ void parse_scene_json(SceneImpl& s) {
       const std::string key = "queries[" + std::to_string(i) + "]";
       const std::string name = p.string(q[i], key);
       if (std::find(kQueryNames.begin(), kQueryNames.end(), name) == kQueryNames.end()) {
-        p.fail(key, "must be one of \"distance\", \"ccd\", \"pd\", got " + shown(q[i]));
+        std::string names;
+        for (const auto n : kQueryNames) names += (names.empty() ? "" : ", ") + in_quotes(n);
+        p.fail(key, "must be one of " + names + ", got " + shown(q[i]));
       }
       if (std::find(s.queries.begin(), s.queries.end(), name) != s.queries.end()) {
         p.fail(key, "lists " + in_quotes(name) + " a second time");

@@ -2,13 +2,22 @@
 // Scene input: scene.json (or a bare mesh file) -> frames, loaded one at a time on request.
 #include "core/scene.hpp"
 
+#include <array>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace vproxq {
+
+/// The queries, in canonical order (DESIGN.md, table of queries): what --queries and scene.json
+/// "queries" may list.
+inline constexpr std::array<std::string_view, 3> kQueryNames = {"distance", "ccd", "pd"};
+
+/// kQueryNames joined by ", ", for messages and help.
+std::string query_names_list();
 
 /// How a frame file splits into objects (scene.json "objects").
 enum class ObjectSplit { Meshes, Components };

@@ -62,6 +62,7 @@ TEST(Cli, HelpAndVersion) {
   auto r = vproxq("--help");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("--queries"), std::string::npos);
+  EXPECT_NE(r.output.find("Valid: distance, ccd, pd"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("Exit codes"), std::string::npos);
   r = vproxq("--version");
   EXPECT_EQ(r.exit_code, 0);
