@@ -21,6 +21,24 @@ IndexRows make_rows(std::size_t rows, std::vector<std::pair<Index, Index>> pairs
   return out;
 }
 
+/// Rows 0..rows-1, row r being what fill(r, row) appends, sorted, duplicates removed. Sorting
+/// each short row on its own is much cheaper than sorting all (row, value) pairs at once.
+template <typename Fill>
+IndexRows make_rows_by_row(std::size_t rows, const Fill& fill) {
+  IndexRows out;
+  out.offsets.assign(rows + 1, 0);
+  std::vector<Index> row;
+  for (std::size_t r = 0; r < rows; ++r) {
+    row.clear();
+    fill(r, row);
+    std::sort(row.begin(), row.end());
+    row.erase(std::unique(row.begin(), row.end()), row.end());
+    out.values.insert(out.values.end(), row.begin(), row.end());
+    out.offsets[r + 1] = static_cast<Index>(out.values.size());
+  }
+  return out;
+}
+
 }  // namespace
 
 Adjacency::Adjacency(const Topology& topology) {
@@ -58,26 +76,27 @@ Adjacency::Adjacency(const Topology& topology) {
   edge_tris_ = make_rows(edges_.size(), std::move(edge_pairs));
 
   // 1-ring: the triangles of the three vertices, minus t itself.
-  std::vector<std::pair<Index, Index>> r1;
-  for (std::size_t t = 0; t < nt; ++t)
+  ring1_ = make_rows_by_row(nt, [&](std::size_t t, std::vector<Index>& row) {
     for (Index v : topology.faces[t])
       for (Index g : vertex_triangles(v))
-        if (g != static_cast<Index>(t)) r1.emplace_back(static_cast<Index>(t), g);
-  ring1_ = make_rows(nt, std::move(r1));
+        if (g != static_cast<Index>(t)) row.push_back(g);
+  });
 
-  // 2-ring: the 1-rings of the 1-ring, minus t and its 1-ring.
-  std::vector<std::pair<Index, Index>> r2;
-  std::vector<Index> row;
-  for (std::size_t t = 0; t < nt; ++t) {
-    row.clear();
+  // 2-ring: the 1-rings of the 1-ring, minus t and its 1-ring. mark[h] == t + 1: h is t, in
+  // its 1-ring, or already in its row.
+  std::vector<std::size_t> mark(nt, 0);
+  ring2_ = make_rows_by_row(nt, [&](std::size_t t, std::vector<Index>& row) {
     const IndexSpan own = ring1(static_cast<Index>(t));
+    mark[t] = t + 1;
+    for (Index g : own) mark[static_cast<std::size_t>(g)] = t + 1;
     for (Index g : own)
-      for (Index h : ring1(g))
-        if (h != static_cast<Index>(t) && !std::binary_search(own.begin(), own.end(), h))
-          row.push_back(h);
-    for (Index h : row) r2.emplace_back(static_cast<Index>(t), h);
-  }
-  ring2_ = make_rows(nt, std::move(r2));
+      for (Index h : ring1(g)) {
+        std::size_t& m = mark[static_cast<std::size_t>(h)];
+        if (m == t + 1) continue;
+        m = t + 1;
+        row.push_back(h);
+      }
+  });
 }
 
 Index Adjacency::find_edge(Index a, Index b) const {
