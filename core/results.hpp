@@ -52,9 +52,12 @@ struct DistanceCounters {
   std::uint64_t feature_pns = 0;   ///< feature-level PNS: (triangle, object) pairs kept by culling
   std::uint64_t exact_tests = 0;       ///< triangle–triangle distance evaluations
   /// Intra-object query: non-adjacent (f, g) pairs whose boxes passed the AABB test, how many of
-  /// those Stage II's bounds culled, and the triangle–triangle distance evaluations that ran.
+  /// those Stage II's bounds culled, how many were not evaluated again because g's search had
+  /// already evaluated (g, f), and the triangle–triangle distance evaluations that ran. With
+  /// more than one thread, the last two depend on the threads' timing (the results do not).
   std::uint64_t intra_candidates = 0;
   std::uint64_t intra_voronoi_culled = 0;
+  std::uint64_t intra_reused = 0;
   std::uint64_t intra_exact_tests = 0;
 };
 

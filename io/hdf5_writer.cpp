@@ -607,6 +607,7 @@ struct Hdf5ResultWriter::Impl {
       write_attribute(s, stats_where, "intra_exact_tests", std::uint64_t{frame.counters.intra_exact_tests});
       write_attribute(s, stats_where, "intra_candidates", std::uint64_t{frame.counters.intra_candidates});
       write_attribute(s, stats_where, "intra_voronoi_culled", std::uint64_t{frame.counters.intra_voronoi_culled});
+      write_attribute(s, stats_where, "intra_reused", std::uint64_t{frame.counters.intra_reused});
     }
     if (frame.self_voronoi) {
       const VoronoiFrameStats& v = *frame.self_voronoi;

@@ -212,6 +212,7 @@ Json frame_json(const FrameResult& frame, double write_ms) {
     stats["intra_exact_tests"] = frame.counters.intra_exact_tests;
     stats["intra_candidates"] = frame.counters.intra_candidates;
     stats["intra_voronoi_culled"] = frame.counters.intra_voronoi_culled;
+    stats["intra_reused"] = frame.counters.intra_reused;
   }
   if (frame.voronoi) {
     const VoronoiFrameStats& v = *frame.voronoi;

@@ -7,6 +7,7 @@
 #include "core/voronoi/self_stage2.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <tuple>
 
@@ -49,6 +50,67 @@ void finish_object(IntraObjectDistance& out) {
     }
   }
 }
+
+
+/// The per-triangle records of one object while its triangles' searches run in parallel, and
+/// what lets each pair be evaluated once instead of once from each side. Every evaluated pair
+/// is offered to both triangles' records (under a lock per record), and a triangle's search
+/// marks it done when it ends; its record then holds its final answer (every pair within its
+/// bound was evaluated, by it or offered by the other side). f's search skips a candidate g
+/// whose search is done when g's search cannot have skipped f: f's box lies within g's final
+/// bound (<= every bound g's search used) and f's D_l does not exceed it, so g evaluated the
+/// pair and offered it to f. Offers are kept by the smallest (distance, id) as from f's own
+/// evaluation (evaluate() gives both sides bitwise the same numbers), so the records end the
+/// same whichever thread evaluates which pair.
+class SharedPairs {
+ public:
+  explicit SharedPairs(size_t n) : current_(n), done_(n), locks_(n) {
+    for (auto& c : current_) c.store(kInfinity, std::memory_order_relaxed);
+    for (auto& d : done_) d.store(false, std::memory_order_relaxed);
+    for (auto& l : locks_) l.store(false, std::memory_order_relaxed);
+  }
+
+  /// t's best distance so far (never below its final answer).
+  double current(size_t t) const { return current_[t].load(std::memory_order_relaxed); }
+
+  /// Whether t's search has ended (then current(t) is its final answer).
+  bool done(size_t t) const { return done_[t].load(std::memory_order_acquire); }
+  void finish(size_t t) { done_[t].store(true, std::memory_order_release); }
+
+  /// Offers t the pair (t, other), r being its evaluation from the searching triangle's side:
+  /// t's own side, or, with `swap`, other's.
+  void offer(IntraTriangleNearest& best, size_t t, Index other, const TriangleDistanceResult& r,
+             bool swap) {
+    Lock lock(locks_[t]);
+    if (std::tie(r.distance, other) >= std::tie(best.distance, best.nearest)) return;
+    best.nearest = other;
+    best.distance = r.distance;
+    if (swap) {
+      best.points = {r.point_b, r.point_a};
+      best.kind = r.kind == TriangleDistanceCase::VertexFace   ? TriangleDistanceCase::FaceVertex
+                  : r.kind == TriangleDistanceCase::FaceVertex ? TriangleDistanceCase::VertexFace
+                                                               : r.kind;
+    } else {
+      best.points = {r.point_a, r.point_b};
+      best.kind = r.kind;
+    }
+    current_[t].store(r.distance, std::memory_order_relaxed);
+  }
+
+ private:
+  /// A spin lock per record: offers are short and rarely contended.
+  struct Lock {
+    explicit Lock(std::atomic<bool>& f) : flag(f) {
+      while (flag.exchange(true, std::memory_order_acquire)) {
+      }
+    }
+    ~Lock() { flag.store(false, std::memory_order_release); }
+    std::atomic<bool>& flag;
+  };
+  std::vector<std::atomic<double>> current_;
+  std::vector<std::atomic<bool>> done_;
+  std::vector<std::atomic<bool>> locks_;
+};
 
 bool shares_vertex(const Object& o, Index f, Index g) {
   return Adjacency::share_vertex(o.topology->faces[static_cast<size_t>(f)],
@@ -108,32 +170,48 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     bvh.build(tboxes);
     const double* upper = opts.voronoi ? opts.voronoi->triangle_upper[i].data() : nullptr;
     const double* lower = opts.voronoi ? opts.voronoi->triangle_lower[i].data() : nullptr;
+    // D_u(t): the 2-ring bound, or Stage II's (which already includes it) when smaller.
+    auto upper_of = [&](size_t t) { return upper ? std::min(ring2_bound[i][t], upper[t]) : ring2_bound[i][t]; };
+    SharedPairs shared(n);
     std::vector<DistanceCounters> counters((n + kBlock - 1) / kBlock);
     parallel_for(counters.size(), threads, [&](size_t block) {
       DistanceCounters& c = counters[block];
       for (size_t uf = block * kBlock; uf < std::min(n, (block + 1) * kBlock); ++uf) {
         const Index f = static_cast<Index>(uf);
-        // D_u(f): the 2-ring bound, or Stage II's (which already includes it) when smaller.
-        const double u = upper ? std::min(ring2_bound[i][uf], upper[uf]) : ring2_bound[i][uf];
-        IntraTriangleNearest& best = res.per_triangle[uf];
-        auto bound = [&] { return std::min(u, best.distance) + slack; };
+        const double u = upper_of(uf);
+        auto bound = [&] { return std::min(u, shared.current(uf)) + slack; };
         // Nearest boxes first, so that the bound drops early. A pair at distance d <= bound
         // has D_l(g) <= SD(g) <= d (f is non-adjacent to g), so the D_l cut loses nothing.
-        bvh.query(tboxes[uf], bound, [&](Index g, double) {
+        bvh.query(tboxes[uf], bound, [&](Index g, double box_d2) {
           if (g == f || shares_vertex(o, f, g)) return;
           ++c.intra_candidates;
           if (lower && lower[g] > bound()) {
             ++c.intra_voronoi_culled;
             return;
           }
+          // g's finished search already evaluated this pair and offered it to f when f's box
+          // lay within g's final bound (its last and smallest) and f's D_l did not cull it
+          // there (see SharedPairs).
+          const size_t ug = static_cast<size_t>(g);
+          if (shared.done(ug)) {
+            const double bg = std::min(upper_of(ug), shared.current(ug)) + slack;
+            if (box_d2 <= bg * bg && (!lower || lower[uf] <= bg)) {
+              ++c.intra_reused;
+              return;
+            }
+          }
           ++c.intra_exact_tests;
-          consider(o, f, g, best);
+          const TriangleDistanceResult r = evaluate(o, f, g);
+          shared.offer(res.per_triangle[uf], uf, g, r, false);
+          shared.offer(res.per_triangle[ug], ug, f, r, true);
         });
+        shared.finish(uf);
       }
     });
     for (const auto& c : counters) {
       out.counters.intra_candidates += c.intra_candidates;
       out.counters.intra_voronoi_culled += c.intra_voronoi_culled;
+      out.counters.intra_reused += c.intra_reused;
       out.counters.intra_exact_tests += c.intra_exact_tests;
     }
     finish_object(res);
