@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <memory>
 #include <cmath>
 #include <tuple>
 
@@ -120,26 +121,35 @@ bool shares_vertex(const Object& o, Index f, Index g) {
 }  // namespace
 
 std::vector<std::vector<double>> ring2_upper_bounds(const Frame& frame, int threads) {
-  std::vector<std::vector<double>> out(frame.objects.size());
-  for (size_t i = 0; i < frame.objects.size(); ++i) {
-    const Object& o = frame.objects[i];
-    const size_t n = static_cast<size_t>(o.num_triangles());
+  const size_t n_obj = frame.objects.size();
+  std::vector<std::vector<double>> out(n_obj);
+  // Work items: blocks of kBlock triangles over all objects, after each object's adjacency.
+  std::vector<size_t> first_block(n_obj + 1, 0);
+  for (size_t i = 0; i < n_obj; ++i) {
+    const size_t n = static_cast<size_t>(frame.objects[i].num_triangles());
     out[i].assign(n, kInfinity);
-    if (n == 0) continue;
-    const Adjacency& adj = adjacency(*o.topology);
-    const auto& faces = o.topology->faces;
-    parallel_for((n + kBlock - 1) / kBlock, threads, [&](size_t block) {
-      for (size_t f = block * kBlock; f < std::min(n, (block + 1) * kBlock); ++f) {
-        double best2 = kInfinity;
-        for (Index g : adj.ring2(static_cast<Index>(f)))
-          for (Index a : faces[f])
-            for (Index b : faces[static_cast<size_t>(g)])
-              best2 = std::min(best2, (o.positions[static_cast<size_t>(a)] -
-                                       o.positions[static_cast<size_t>(b)]).squaredNorm());
-        out[i][f] = std::sqrt(best2) * (1 + kUpperBoundWidening);
-      }
-    });
+    first_block[i + 1] = first_block[i] + (n + kBlock - 1) / kBlock;
   }
+  std::vector<const Adjacency*> adj(n_obj, nullptr);
+  parallel_for(n_obj, threads, [&](size_t i) {
+    if (!out[i].empty()) adj[i] = &adjacency(*frame.objects[i].topology);
+  });
+  parallel_for(first_block[n_obj], threads, [&](size_t item) {
+    const size_t i = static_cast<size_t>(
+        std::upper_bound(first_block.begin(), first_block.end(), item) - first_block.begin() - 1);
+    const size_t block = item - first_block[i];
+    const Object& o = frame.objects[i];
+    const auto& faces = o.topology->faces;
+    for (size_t f = block * kBlock; f < std::min(out[i].size(), (block + 1) * kBlock); ++f) {
+      double best2 = kInfinity;
+      for (Index g : adj[i]->ring2(static_cast<Index>(f)))
+        for (Index a : faces[f])
+          for (Index b : faces[static_cast<size_t>(g)])
+            best2 = std::min(best2, (o.positions[static_cast<size_t>(a)] -
+                                     o.positions[static_cast<size_t>(b)]).squaredNorm());
+      out[i][f] = std::sqrt(best2) * (1 + kUpperBoundWidening);
+    }
+  });
   return out;
 }
 
@@ -158,64 +168,78 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
   const double slack = rounding_slack(boxes.magnitude);
   const size_t n_obj = frame.objects.size();
   out.per_object.resize(n_obj);
+  // Work items: blocks of kBlock triangles over all objects (first_block[i]: object i's first),
+  // so that many small objects keep the threads as busy as one large one.
+  std::vector<size_t> first_block(n_obj + 1, 0);
   for (size_t i = 0; i < n_obj; ++i) {
+    const size_t n = static_cast<size_t>(frame.objects[i].num_triangles());
+    out.per_object[i].object = static_cast<Index>(i);
+    out.per_object[i].per_triangle.assign(n, {});
+    first_block[i + 1] = first_block[i] + (n < 2 ? 0 : (n + kBlock - 1) / kBlock);
+  }
+  std::vector<TriangleBvh> bvhs(n_obj);
+  std::vector<std::unique_ptr<SharedPairs>> shared(n_obj);
+  parallel_for(n_obj, threads, [&](size_t i) {
+    if (first_block[i + 1] == first_block[i]) return;
+    bvhs[i].build(boxes.triangles[i]);
+    shared[i] = std::make_unique<SharedPairs>(boxes.triangles[i].size());
+  });
+
+  std::vector<DistanceCounters> counters(first_block[n_obj]);
+  parallel_for(counters.size(), threads, [&](size_t item) {
+    const size_t i = static_cast<size_t>(
+        std::upper_bound(first_block.begin(), first_block.end(), item) - first_block.begin() - 1);
+    const size_t block = item - first_block[i];
     const Object& o = frame.objects[i];
     IntraObjectDistance& res = out.per_object[i];
-    res.object = static_cast<Index>(i);
-    const size_t n = static_cast<size_t>(o.num_triangles());
-    res.per_triangle.assign(n, {});
-    if (n < 2) continue;
+    const size_t n = res.per_triangle.size();
     const auto& tboxes = boxes.triangles[i];
-    TriangleBvh bvh;
-    bvh.build(tboxes);
+    const TriangleBvh& bvh = bvhs[i];
+    SharedPairs& pairs = *shared[i];
     const double* upper = opts.voronoi ? opts.voronoi->triangle_upper[i].data() : nullptr;
     const double* lower = opts.voronoi ? opts.voronoi->triangle_lower[i].data() : nullptr;
     // D_u(t): the 2-ring bound, or Stage II's (which already includes it) when smaller.
     auto upper_of = [&](size_t t) { return upper ? std::min(ring2_bound[i][t], upper[t]) : ring2_bound[i][t]; };
-    SharedPairs shared(n);
-    std::vector<DistanceCounters> counters((n + kBlock - 1) / kBlock);
-    parallel_for(counters.size(), threads, [&](size_t block) {
-      DistanceCounters& c = counters[block];
-      for (size_t uf = block * kBlock; uf < std::min(n, (block + 1) * kBlock); ++uf) {
-        const Index f = static_cast<Index>(uf);
-        const double u = upper_of(uf);
-        auto bound = [&] { return std::min(u, shared.current(uf)) + slack; };
-        // Nearest boxes first, so that the bound drops early. A pair at distance d <= bound
-        // has D_l(g) <= SD(g) <= d (f is non-adjacent to g), so the D_l cut loses nothing.
-        bvh.query(tboxes[uf], bound, [&](Index g, double box_d2) {
-          if (g == f || shares_vertex(o, f, g)) return;
-          ++c.intra_candidates;
-          if (lower && lower[g] > bound()) {
-            ++c.intra_voronoi_culled;
+    DistanceCounters& c = counters[item];
+    for (size_t uf = block * kBlock; uf < std::min(n, (block + 1) * kBlock); ++uf) {
+      const Index f = static_cast<Index>(uf);
+      const double u = upper_of(uf);
+      auto bound = [&] { return std::min(u, pairs.current(uf)) + slack; };
+      // Nearest boxes first, so that the bound drops early. A pair at distance d <= bound
+      // has D_l(g) <= SD(g) <= d (f is non-adjacent to g), so the D_l cut loses nothing.
+      bvh.query(tboxes[uf], bound, [&](Index g, double box_d2) {
+        if (g == f || shares_vertex(o, f, g)) return;
+        ++c.intra_candidates;
+        if (lower && lower[g] > bound()) {
+          ++c.intra_voronoi_culled;
+          return;
+        }
+        // g's finished search already evaluated this pair and offered it to f when f's box
+        // lay within g's final bound (its last and smallest) and f's D_l did not cull it
+        // there (see SharedPairs).
+        const size_t ug = static_cast<size_t>(g);
+        if (pairs.done(ug)) {
+          const double bg = std::min(upper_of(ug), pairs.current(ug)) + slack;
+          if (box_d2 <= bg * bg && (!lower || lower[uf] <= bg)) {
+            ++c.intra_reused;
             return;
           }
-          // g's finished search already evaluated this pair and offered it to f when f's box
-          // lay within g's final bound (its last and smallest) and f's D_l did not cull it
-          // there (see SharedPairs).
-          const size_t ug = static_cast<size_t>(g);
-          if (shared.done(ug)) {
-            const double bg = std::min(upper_of(ug), shared.current(ug)) + slack;
-            if (box_d2 <= bg * bg && (!lower || lower[uf] <= bg)) {
-              ++c.intra_reused;
-              return;
-            }
-          }
-          ++c.intra_exact_tests;
-          const TriangleDistanceResult r = evaluate(o, f, g);
-          shared.offer(res.per_triangle[uf], uf, g, r, false);
-          shared.offer(res.per_triangle[ug], ug, f, r, true);
-        });
-        shared.finish(uf);
-      }
-    });
-    for (const auto& c : counters) {
-      out.counters.intra_candidates += c.intra_candidates;
-      out.counters.intra_voronoi_culled += c.intra_voronoi_culled;
-      out.counters.intra_reused += c.intra_reused;
-      out.counters.intra_exact_tests += c.intra_exact_tests;
+        }
+        ++c.intra_exact_tests;
+        const TriangleDistanceResult r = evaluate(o, f, g);
+        pairs.offer(res.per_triangle[uf], uf, g, r, false);
+        pairs.offer(res.per_triangle[ug], ug, f, r, true);
+      });
+      pairs.finish(uf);
     }
-    finish_object(res);
+  });
+  for (const auto& c : counters) {
+    out.counters.intra_candidates += c.intra_candidates;
+    out.counters.intra_voronoi_culled += c.intra_voronoi_culled;
+    out.counters.intra_reused += c.intra_reused;
+    out.counters.intra_exact_tests += c.intra_exact_tests;
   }
+  parallel_for(n_obj, threads, [&](size_t i) { finish_object(out.per_object[i]); });
   out.exact_ms = sw.elapsed_ms();
   return out;
 }
