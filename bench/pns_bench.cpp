@@ -12,7 +12,8 @@
 //   floor     pairs that no search pruning by triangle boxes can skip: those whose boxes lie
 //             within the final answer (off), and, with Stage II, of them those where both
 //             triangles' D_l are within it too (cpu). Stage III can only get below these by
-//             ties.
+//             ties, and, intra, because it evaluates a pair once for both triangles while
+//             the floor counts (f, g) and (g, f) apart.
 //   fixed     the feature-level PNS of the paper (5.2.1) with its fixed bounds: every pair
 //             whose boxes lie within the object's (or, for intra, the triangle's) upper bound,
 //             the bound being Stage I's U_i (inter) or the 2-ring bound (intra) without Stage
