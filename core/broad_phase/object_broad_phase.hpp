@@ -2,8 +2,12 @@
 // Stage I (paper 5.1): object AABBs, sorted intervals per axis, a conservative upper bound on
 // each object's separation distance, and the object-level potentially neighbouring sets (PNS).
 #include "core/broad_phase/aabb.hpp"
+#include "core/broad_phase/triangle_bvh.hpp"
+#include "core/parallel.hpp"
 #include "core/scene.hpp"
 
+#include <memory>
+#include <mutex>
 #include <vector>
 
 namespace vproxq {
@@ -15,7 +19,35 @@ struct FrameBoxes {
   double magnitude = 0;                      ///< largest |coordinate| of any triangle corner
 
   static FrameBoxes compute(const Frame& frame, int threads);
+
+  /// Object i's BVH over triangles[i], built on first use (safe from several threads at once)
+  /// and then shared by every query of the frame, and by copies of this FrameBoxes.
+  const TriangleBvh& bvh(std::size_t i) const;
+  /// Builds the BVHs of the objects for which want(i) holds, on `threads` threads.
+  template <typename Want>
+  void build_bvhs(int threads, const Want& want) const;
+
+  struct BvhCache;
+  std::shared_ptr<BvhCache> bvh_cache;  ///< set by compute()
 };
+
+struct FrameBoxes::BvhCache {
+  explicit BvhCache(std::size_t n) : once(n), bvhs(n) {}
+  std::vector<std::once_flag> once;
+  std::vector<TriangleBvh> bvhs;
+};
+
+inline const TriangleBvh& FrameBoxes::bvh(std::size_t i) const {
+  std::call_once(bvh_cache->once[i], [&] { bvh_cache->bvhs[i].build(triangles[i]); });
+  return bvh_cache->bvhs[i];
+}
+
+template <typename Want>
+void FrameBoxes::build_bvhs(int threads, const Want& want) const {
+  parallel_for(triangles.size(), threads, [&](std::size_t i) {
+    if (want(i)) bvh(i);
+  });
+}
 
 struct ObjectBroadPhase {
   /// U_i: the distance from object i to some other object is at most this (kInfinity when

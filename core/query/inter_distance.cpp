@@ -87,7 +87,7 @@ struct SearchScratch {
 /// probes' distances), each once the search has run up to its box distance. A pair (f, g) at
 /// distance d <= bound has D_l(f) <= d and D_l(g) <= d (each is at most d from some other
 /// object), so the D_l cuts lose nothing. `u` is D_u(O_i) from Stage I or II.
-void search_object(const Frame& frame, const FrameBoxes& boxes, const std::vector<TriangleBvh>& bvhs,
+void search_object(const Frame& frame, const FrameBoxes& boxes,
                    const std::vector<Index>& pns, Index i, double u, double slack,
                    const VoronoiBounds* voronoi, Best& best, SearchScratch& scratch,
                    DistanceCounters& counters) {
@@ -121,7 +121,7 @@ void search_object(const Frame& frame, const FrameBoxes& boxes, const std::vecto
       if ((low_i && low_i[t] > b) || best.contact_prunes(j, t)) continue;
       const AABB& box_t = tb_i[static_cast<size_t>(t)];
       if (box_distance_squared(box_t, box_j) > b * b) continue;
-      scratch.search.add(bvhs[static_cast<size_t>(j)], box_t, b);
+      scratch.search.add(boxes.bvh(static_cast<size_t>(j)), box_t, b);
       scratch.probe_pair.emplace_back(j, t);
       ++counters.feature_pns;
     }
@@ -151,8 +151,7 @@ InterDistanceOutput inter_object_distance(const Frame& frame, const FrameBoxes& 
   const double slack = rounding_slack(boxes.magnitude);
   Stopwatch sw;
   out.per_object.resize(n);
-  std::vector<TriangleBvh> bvhs(n);
-  parallel_for(n, threads, [&](size_t i) { bvhs[i].build(boxes.triangles[i]); });
+  boxes.build_bvhs(threads, [](size_t) { return true; });
   std::vector<DistanceCounters> counters(n);
   parallel_for(n, threads, [&](size_t ui) {
     const Index i = static_cast<Index>(ui);
@@ -160,7 +159,7 @@ InterDistanceOutput inter_object_distance(const Frame& frame, const FrameBoxes& 
     thread_local SearchScratch scratch;
     // D_u(O_i): Stage II's bound when it ran, else Stage I's.
     const double u = opts.voronoi ? opts.voronoi->object_upper[ui] : stage1.upper_bound[ui];
-    search_object(frame, boxes, bvhs, stage1.pns[ui], i, u, slack, opts.voronoi, best, scratch,
+    search_object(frame, boxes, stage1.pns[ui], i, u, slack, opts.voronoi, best, scratch,
                   counters[ui]);
     out.per_object[ui] = to_result(i, best);
   });

@@ -78,10 +78,7 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
       needs_bvh[i] = 1;
     }
   }
-  std::vector<TriangleBvh> bvhs(n);
-  parallel_for(n, threads, [&](size_t i) {
-    if (needs_bvh[i]) bvhs[i].build(boxes.triangles[i]);
-  });
+  boxes.build_bvhs(threads, [&](size_t i) { return needs_bvh[i] != 0; });
 
   const VoronoiBounds* voronoi = opts.voronoi;
   std::vector<std::vector<IntersectingPair>> found(items.size());
@@ -96,7 +93,7 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
     if (w.i == w.j) {
       for (Index f = w.first; f < w.last; ++f) {
         const Face& ff = oi.topology->faces[static_cast<size_t>(f)];
-        bvhs[static_cast<size_t>(w.i)].query(tb_i[static_cast<size_t>(f)], zero, [&](Index g, double) {
+        boxes.bvh(static_cast<size_t>(w.i)).query(tb_i[static_cast<size_t>(f)], zero, [&](Index g, double) {
           if (g <= f || Adjacency::share_vertex(ff, oi.topology->faces[static_cast<size_t>(g)])) return;
           ++tests[k];
           if (triangles_intersect(oi.triangle(f), oi.triangle(g))) hits.push_back({w.i, f, w.i, g});
@@ -112,7 +109,7 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
         if (low_i && low_i[f] > 0.0) continue;
         const AABB& bf = tb_i[static_cast<size_t>(f)];
         if (!boxes_overlap(bf, box_j)) continue;
-        bvhs[static_cast<size_t>(w.j)].query(bf, zero, [&](Index g, double) {
+        boxes.bvh(static_cast<size_t>(w.j)).query(bf, zero, [&](Index g, double) {
           if (low_j && low_j[g] > 0.0) return;
           ++tests[k];
           if (triangles_intersect(oi.triangle(f), oj.triangle(g))) hits.push_back({w.i, f, w.j, g});

@@ -177,11 +177,10 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     out.per_object[i].per_triangle.assign(n, {});
     first_block[i + 1] = first_block[i] + (n < 2 ? 0 : (n + kBlock - 1) / kBlock);
   }
-  std::vector<TriangleBvh> bvhs(n_obj);
   std::vector<std::unique_ptr<SharedPairs>> shared(n_obj);
   parallel_for(n_obj, threads, [&](size_t i) {
     if (first_block[i + 1] == first_block[i]) return;
-    bvhs[i].build(boxes.triangles[i]);
+    boxes.bvh(i);
     shared[i] = std::make_unique<SharedPairs>(boxes.triangles[i].size());
   });
 
@@ -194,7 +193,7 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     IntraObjectDistance& res = out.per_object[i];
     const size_t n = res.per_triangle.size();
     const auto& tboxes = boxes.triangles[i];
-    const TriangleBvh& bvh = bvhs[i];
+    const TriangleBvh& bvh = boxes.bvh(i);
     SharedPairs& pairs = *shared[i];
     const double* upper = opts.voronoi ? opts.voronoi->triangle_upper[i].data() : nullptr;
     const double* lower = opts.voronoi ? opts.voronoi->triangle_lower[i].data() : nullptr;

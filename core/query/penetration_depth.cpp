@@ -861,15 +861,13 @@ PenetrationDepthOutput penetration_depth(const Frame& frame, const FrameBoxes& b
     involved[static_cast<size_t>(intersecting[k].object_b)] = 1;
     k = e;
   }
-  std::vector<TriangleBvh> bvhs(n);
   std::vector<PdStatus> surface(n, PdStatus::Ok);
+  std::vector<ObjectView> views(n);
   parallel_for(n, threads, [&](size_t i) {
     if (!involved[i]) return;
-    bvhs[i].build(boxes.triangles[i]);
+    views[i] = {&frame.objects[i], &boxes.bvh(i)};
     surface[i] = surface_status(*frame.objects[i].topology);
   });
-  std::vector<ObjectView> views(n);
-  for (size_t i = 0; i < n; ++i) views[i] = {&frame.objects[i], &bvhs[i]};
   out.pairs.resize(runs.size());
   parallel_for(runs.size(), threads, [&](size_t r) {
     out.pairs[r] = pair_depth(views, surface, intersecting.begin() + static_cast<std::ptrdiff_t>(runs[r].first),
