@@ -187,6 +187,7 @@ CcdSweep CcdSweep::compute(const Frame& from, const Frame& to, int threads) {
   const size_t n = from.objects.size();
   s.triangles.assign(n, {});
   s.objects.assign(n, AABB{});
+  s.vertices.assign(n, {});
   // Margin from the coordinates of the step (both frames, participating objects).
   AABB all;
   double magnitude = 0;
@@ -204,12 +205,17 @@ CcdSweep CcdSweep::compute(const Frame& from, const Frame& to, int threads) {
     const size_t i = static_cast<size_t>(ids[k]);
     const Object& a = from.objects[i];
     const Object& b = to.objects[i];
+    auto& vb = s.vertices[i];
+    vb.resize(a.positions.size());
+    for (size_t v = 0; v < vb.size(); ++v) vb[v] = swept_box(a, b, {static_cast<Index>(v)});
     auto& tb = s.triangles[i];
     tb.resize(static_cast<size_t>(a.num_triangles()));
     AABB box;
     for (Index t = 0; t < a.num_triangles(); ++t) {
       const Face& f = a.topology->faces[static_cast<size_t>(t)];
-      AABB tri = swept_box(a, b, {f[0], f[1], f[2]});
+      AABB tri = vb[static_cast<size_t>(f[0])];
+      tri.extend(vb[static_cast<size_t>(f[1])]);
+      tri.extend(vb[static_cast<size_t>(f[2])]);
       tri.lo.array() -= s.margin;
       tri.hi.array() += s.margin;
       tb[static_cast<size_t>(t)] = tri;
@@ -285,25 +291,32 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
     const Task& task = tasks[k];
     const Index i = task.i, j = task.j;
     const Object& oi = from.objects[static_cast<size_t>(i)];
-    const Object& oi1 = to.objects[static_cast<size_t>(i)];
     const Object& oj = from.objects[static_cast<size_t>(j)];
-    const Object& oj1 = to.objects[static_cast<size_t>(j)];
     const Adjacency& adj_i = adjacency(*oi.topology);
     const Adjacency& adj_j = adjacency(*oj.topology);
     const Ownership& own_i = owners[static_cast<size_t>(i)];
     const Ownership& own_j = owners[static_cast<size_t>(j)];
     const auto& tb_i = sweep.triangles[static_cast<size_t>(i)];
     const auto& tb_j = sweep.triangles[static_cast<size_t>(j)];
+    const auto& vb_i = sweep.vertices[static_cast<size_t>(i)];
+    const auto& vb_j = sweep.vertices[static_cast<size_t>(j)];
+    // A segment's swept box: the union of its two vertices' (the same min/max as boxing all
+    // four positions).
+    auto edge_box = [](const std::vector<AABB>& vb, const std::array<Index, 2>& e) {
+      AABB box = vb[static_cast<size_t>(e[0])];
+      box.extend(vb[static_cast<size_t>(e[1])]);
+      return box;
+    };
     const AABB& box_j = sweep.objects[static_cast<size_t>(j)];
     const bool self = i == j;
     Hits& hits = parts[k];
 
     // Vertex v of object ov (owned by tri fv) against face g of object og.
-    auto vertex_face = [&](Index ov, const Object& a0, const Object& a1, Index v, Index og,
+    auto vertex_face = [&](Index ov, const std::vector<AABB>& v_boxes, Index v, Index og,
                            const Face& g_face, Index g, const AABB& g_box) {
       if (self && in_face(v, g_face)) return;
       // The vertex's own swept box against the face's widened one: exact comparisons.
-      if (!boxes_overlap(swept_box(a0, a1, {v}), g_box)) return;
+      if (!boxes_overlap(v_boxes[static_cast<size_t>(v)], g_box)) return;
       tester.vertex_face(ov, v, og, g, hits);
     };
 
@@ -323,20 +336,20 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
         const Face& gf = oj.topology->faces[static_cast<size_t>(g)];
         const AABB& gb = tb_j[static_cast<size_t>(g)];
         for (Index v : ff)
-          if (own_i.vertex[static_cast<size_t>(v)] == f) vertex_face(i, oi, oi1, v, j, gf, g, gb);
+          if (own_i.vertex[static_cast<size_t>(v)] == f) vertex_face(i, vb_i, v, j, gf, g, gb);
         for (Index w : gf)
-          if (own_j.vertex[static_cast<size_t>(w)] == g) vertex_face(j, oj, oj1, w, i, ff, f, fb);
+          if (own_j.vertex[static_cast<size_t>(w)] == g) vertex_face(j, vb_j, w, i, ff, f, fb);
         const auto& fe = adj_i.triangle_edges(f);
         const auto& ge = adj_j.triangle_edges(g);
         for (Index ea : fe) {
           if (ea == kNoIndex || own_i.edge[static_cast<size_t>(ea)] != f) continue;
           const auto& va = adj_i.edges()[static_cast<size_t>(ea)];
-          const AABB ba = swept_box(oi, oi1, {va[0], va[1]});
+          const AABB ba = edge_box(vb_i, va);
           for (Index eb : ge) {
             if (eb == kNoIndex || own_j.edge[static_cast<size_t>(eb)] != g) continue;
             const auto& vb = adj_j.edges()[static_cast<size_t>(eb)];
             if (self && share_endpoint(va, vb)) continue;
-            AABB bb = swept_box(oj, oj1, {vb[0], vb[1]});
+            AABB bb = edge_box(vb_j, vb);
             bb.lo.array() -= sweep.margin;
             bb.hi.array() += sweep.margin;
             if (!boxes_overlap(ba, bb)) continue;

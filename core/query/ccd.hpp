@@ -51,6 +51,9 @@ struct CcdSweep {
   /// [object][triangle] swept boxes (widened), empty for skipped objects.
   std::vector<std::vector<AABB>> triangles;
   std::vector<AABB> objects;  ///< union of an object's swept triangle boxes
+  /// [object][vertex] the segment from the vertex's start to its end position, boxed (not
+  /// widened), empty for skipped objects.
+  std::vector<std::vector<AABB>> vertices;
   static CcdSweep compute(const Frame& from, const Frame& to, int threads);
 };
 
