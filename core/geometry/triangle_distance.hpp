@@ -43,10 +43,8 @@ TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b);
 /// triangle_distance(a, b) when `a_first`, else triangle_distance(b, a) seen from a's side
 /// (points, features and the vertex–face case swapped). Callers that must get bitwise the
 /// same numbers for (a, b) and (b, a) pass a fixed order, e.g. "lower id first".
-inline TriangleDistanceResult triangle_distance_ordered(const Triangle& a, const Triangle& b,
-                                                        bool a_first) {
-  if (a_first) return triangle_distance(a, b);
-  TriangleDistanceResult r = triangle_distance(b, a);
+/// r seen from the other triangle's side: points, features and the vertex–face case swapped.
+inline TriangleDistanceResult swapped(TriangleDistanceResult r) {
   std::swap(r.point_a, r.point_b);
   std::swap(r.feature_a, r.feature_b);
   if (r.kind == TriangleDistanceCase::VertexFace)
@@ -54,6 +52,11 @@ inline TriangleDistanceResult triangle_distance_ordered(const Triangle& a, const
   else if (r.kind == TriangleDistanceCase::FaceVertex)
     r.kind = TriangleDistanceCase::VertexFace;
   return r;
+}
+
+inline TriangleDistanceResult triangle_distance_ordered(const Triangle& a, const Triangle& b,
+                                                        bool a_first) {
+  return a_first ? triangle_distance(a, b) : swapped(triangle_distance(b, a));
 }
 
 /// True when the closed triangles a and b share at least one point (exact predicates). A

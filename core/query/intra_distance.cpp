@@ -8,8 +8,8 @@
 
 #include <algorithm>
 #include <atomic>
-#include <memory>
 #include <cmath>
+#include <memory>
 #include <tuple>
 
 namespace vproxq {
@@ -27,16 +27,44 @@ TriangleDistanceResult evaluate(const Object& o, Index f, Index g) {
   return triangle_distance_ordered(o.triangle(f), o.triangle(g), f < g);
 }
 
-/// Keeps the smallest (distance, g): the tie-break shared with the brute force.
-void consider(const Object& o, Index f, Index g, IntraTriangleNearest& best) {
-  const TriangleDistanceResult r = evaluate(o, f, g);
-  if (std::tie(r.distance, g) < std::tie(best.distance, best.nearest)) {
-    best.nearest = g;
-    best.distance = r.distance;
-    best.points = {r.point_a, r.point_b};
-    best.kind = r.kind;
-  }
+/// Keeps the smallest (distance, g), r being f's pair with g from f's side: the tie-break
+/// shared with the brute force. Returns whether best changed.
+bool keep_nearer(IntraTriangleNearest& best, Index g, const TriangleDistanceResult& r) {
+  if (std::tie(r.distance, g) >= std::tie(best.distance, best.nearest)) return false;
+  best.nearest = g;
+  best.distance = r.distance;
+  best.points = {r.point_a, r.point_b};
+  best.kind = r.kind;
+  return true;
 }
+
+void consider(const Object& o, Index f, Index g, IntraTriangleNearest& best) {
+  keep_nearer(best, g, evaluate(o, f, g));
+}
+
+/// Blocks of kBlock triangles over all objects, the work items of the parallel loops, so that
+/// many small objects keep the threads as busy as one large one.
+class ObjectBlocks {
+ public:
+  /// blocks(i): how many blocks object i has.
+  template <typename Blocks>
+  ObjectBlocks(size_t objects, const Blocks& blocks) : first_(objects + 1, 0) {
+    for (size_t i = 0; i < objects; ++i) first_[i + 1] = first_[i] + blocks(i);
+  }
+  static size_t blocks_of(size_t triangles) { return (triangles + kBlock - 1) / kBlock; }
+
+  size_t size() const { return first_.back(); }
+  size_t count(size_t object) const { return first_[object + 1] - first_[object]; }
+  /// Work item -> (object, block of that object).
+  std::pair<size_t, size_t> locate(size_t item) const {
+    const auto it = std::upper_bound(first_.begin(), first_.end(), item) - 1;
+    const size_t object = static_cast<size_t>(it - first_.begin());
+    return {object, item - *it};
+  }
+
+ private:
+  std::vector<size_t> first_;  ///< first item of each object, and the total
+};
 
 /// Fills in the object's minimum from its per-triangle table: smallest (distance, f, g).
 void finish_object(IntraObjectDistance& out) {
@@ -51,7 +79,6 @@ void finish_object(IntraObjectDistance& out) {
     }
   }
 }
-
 
 /// The per-triangle records of one object while its triangles' searches run in parallel, and
 /// what lets each pair be evaluated once instead of once from each side. Every evaluated pair
@@ -78,24 +105,10 @@ class SharedPairs {
   bool done(size_t t) const { return done_[t].load(std::memory_order_acquire); }
   void finish(size_t t) { done_[t].store(true, std::memory_order_release); }
 
-  /// Offers t the pair (t, other), r being its evaluation from the searching triangle's side:
-  /// t's own side, or, with `swap`, other's.
-  void offer(IntraTriangleNearest& best, size_t t, Index other, const TriangleDistanceResult& r,
-             bool swap) {
+  /// Offers t (record `best`) the pair (t, other), r being its evaluation from t's side.
+  void offer(IntraTriangleNearest& best, size_t t, Index other, const TriangleDistanceResult& r) {
     Lock lock(locks_[t]);
-    if (std::tie(r.distance, other) >= std::tie(best.distance, best.nearest)) return;
-    best.nearest = other;
-    best.distance = r.distance;
-    if (swap) {
-      best.points = {r.point_b, r.point_a};
-      best.kind = r.kind == TriangleDistanceCase::VertexFace   ? TriangleDistanceCase::FaceVertex
-                  : r.kind == TriangleDistanceCase::FaceVertex ? TriangleDistanceCase::VertexFace
-                                                               : r.kind;
-    } else {
-      best.points = {r.point_a, r.point_b};
-      best.kind = r.kind;
-    }
-    current_[t].store(r.distance, std::memory_order_relaxed);
+    if (keep_nearer(best, other, r)) current_[t].store(r.distance, std::memory_order_relaxed);
   }
 
  private:
@@ -123,21 +136,16 @@ bool shares_vertex(const Object& o, Index f, Index g) {
 std::vector<std::vector<double>> ring2_upper_bounds(const Frame& frame, int threads) {
   const size_t n_obj = frame.objects.size();
   std::vector<std::vector<double>> out(n_obj);
-  // Work items: blocks of kBlock triangles over all objects, after each object's adjacency.
-  std::vector<size_t> first_block(n_obj + 1, 0);
-  for (size_t i = 0; i < n_obj; ++i) {
-    const size_t n = static_cast<size_t>(frame.objects[i].num_triangles());
-    out[i].assign(n, kInfinity);
-    first_block[i + 1] = first_block[i] + (n + kBlock - 1) / kBlock;
-  }
+  for (size_t i = 0; i < n_obj; ++i)
+    out[i].assign(static_cast<size_t>(frame.objects[i].num_triangles()), kInfinity);
+  const ObjectBlocks blocks(n_obj, [&](size_t i) { return ObjectBlocks::blocks_of(out[i].size()); });
   std::vector<const Adjacency*> adj(n_obj, nullptr);
   parallel_for(n_obj, threads, [&](size_t i) {
     if (!out[i].empty()) adj[i] = &adjacency(*frame.objects[i].topology);
   });
-  parallel_for(first_block[n_obj], threads, [&](size_t item) {
-    const size_t i = static_cast<size_t>(
-        std::upper_bound(first_block.begin(), first_block.end(), item) - first_block.begin() - 1);
-    const size_t block = item - first_block[i];
+  parallel_for(blocks.size(), threads, [&](size_t item) {
+    const auto [object, block] = blocks.locate(item);
+    const size_t i = object;  // a plain variable: lambdas below capture it
     const Object& o = frame.objects[i];
     const auto& faces = o.topology->faces;
     for (size_t f = block * kBlock; f < std::min(out[i].size(), (block + 1) * kBlock); ++f) {
@@ -168,27 +176,26 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
   const double slack = rounding_slack(boxes.magnitude);
   const size_t n_obj = frame.objects.size();
   out.per_object.resize(n_obj);
-  // Work items: blocks of kBlock triangles over all objects (first_block[i]: object i's first),
-  // so that many small objects keep the threads as busy as one large one.
-  std::vector<size_t> first_block(n_obj + 1, 0);
   for (size_t i = 0; i < n_obj; ++i) {
-    const size_t n = static_cast<size_t>(frame.objects[i].num_triangles());
     out.per_object[i].object = static_cast<Index>(i);
-    out.per_object[i].per_triangle.assign(n, {});
-    first_block[i + 1] = first_block[i] + (n < 2 ? 0 : (n + kBlock - 1) / kBlock);
+    out.per_object[i].per_triangle.assign(static_cast<size_t>(frame.objects[i].num_triangles()), {});
   }
+  // Objects of fewer than 2 triangles have no pairs: no blocks.
+  const ObjectBlocks blocks(n_obj, [&](size_t i) {
+    const size_t n = out.per_object[i].per_triangle.size();
+    return n < 2 ? 0 : ObjectBlocks::blocks_of(n);
+  });
   std::vector<std::unique_ptr<SharedPairs>> shared(n_obj);
   parallel_for(n_obj, threads, [&](size_t i) {
-    if (first_block[i + 1] == first_block[i]) return;
-    boxes.bvh(i);
+    if (blocks.count(i) == 0) return;
+    boxes.bvh(i);  // built here, over objects in parallel, rather than by a block's thread
     shared[i] = std::make_unique<SharedPairs>(boxes.triangles[i].size());
   });
 
-  std::vector<DistanceCounters> counters(first_block[n_obj]);
+  std::vector<DistanceCounters> counters(blocks.size());
   parallel_for(counters.size(), threads, [&](size_t item) {
-    const size_t i = static_cast<size_t>(
-        std::upper_bound(first_block.begin(), first_block.end(), item) - first_block.begin() - 1);
-    const size_t block = item - first_block[i];
+    const auto [object, block] = blocks.locate(item);
+    const size_t i = object;  // a plain variable: lambdas below capture it
     const Object& o = frame.objects[i];
     IntraObjectDistance& res = out.per_object[i];
     const size_t n = res.per_triangle.size();
@@ -226,8 +233,8 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
         }
         ++c.intra_exact_tests;
         const TriangleDistanceResult r = evaluate(o, f, g);
-        pairs.offer(res.per_triangle[uf], uf, g, r, false);
-        pairs.offer(res.per_triangle[ug], ug, f, r, true);
+        pairs.offer(res.per_triangle[uf], uf, g, r);
+        pairs.offer(res.per_triangle[ug], ug, f, swapped(r));
       });
       pairs.finish(uf);
     }
