@@ -172,6 +172,7 @@ void run_intra(const Frame& frame, const FrameBoxes& boxes, VoronoiStage& vorono
   result.time_ms.exact += d.exact_ms;
   result.counters.intra_candidates = d.counters.intra_candidates;
   result.counters.intra_voronoi_culled = d.counters.intra_voronoi_culled;
+  result.counters.intra_separation_culled = d.counters.intra_separation_culled;
   result.counters.intra_reused = d.counters.intra_reused;
   result.counters.intra_exact_tests = d.counters.intra_exact_tests;
   result.intra = std::move(d.per_object);

@@ -8,12 +8,14 @@
 // Per frame and query (inter: every object's nearest other object; intra: every triangle's
 // nearest non-adjacent triangle of its own object):
 //   tests     exact tests that vproxq's Stage III ran, AABB-only (off) and with Stage II (cpu):
-//             a nearest-first search whose bound shrinks to the best distance found so far.
+//             a nearest-first search whose bound shrinks to the best distance found so far,
+//             and which skips pairs whose separating-axis bound exceeds it.
 //   floor     pairs that no search pruning by triangle boxes can skip: those whose boxes lie
 //             within the final answer (off), and, with Stage II, of them those where both
-//             triangles' D_l are within it too (cpu). Stage III can only get below these by
-//             ties, and, intra, because it evaluates a pair once for both triangles while
-//             the floor counts (f, g) and (g, f) apart.
+//             triangles' D_l are within it too (cpu). Stage III gets below these through the
+//             separating-axis bound (core/geometry/separation_bound.hpp), ties, and, intra,
+//             because it evaluates a pair once for both triangles while the floor counts
+//             (f, g) and (g, f) apart.
 //   fixed     the feature-level PNS of the paper (5.2.1) with its fixed bounds: every pair
 //             whose boxes lie within the object's (or, for intra, the triangle's) upper bound,
 //             the bound being Stage I's U_i (inter) or the 2-ring bound (intra) without Stage
@@ -269,7 +271,8 @@ int run(const Options& opt) {
   std::printf("all frames\n");
   print_row("inter", sum_inter);
   print_row("intra", sum_intra);
-  std::printf("ratio = off / cpu. tests: Stage III's exact tests (running-best search); floor: "
+  std::printf("ratio = off / cpu. tests: Stage III's exact tests (running-best search with the "
+              "separating-axis bound); floor: "
               "pairs within the final answer that box (and D_l) culling cannot skip; fixed: the "
               "paper's feature-level PNS with fixed bounds (U_i or the 2-ring bound; D_u and "
               "D_l with Stage II).\n");

@@ -51,12 +51,17 @@ struct DistanceCounters {
   std::uint64_t object_pns_pairs = 0;  ///< ordered object pairs (i, j) kept by the broad phase
   std::uint64_t feature_pns = 0;   ///< feature-level PNS: (triangle, object) pairs kept by culling
   std::uint64_t exact_tests = 0;       ///< triangle–triangle distance evaluations
+  /// Triangle pairs whose boxes were within the bound but that the separating-axis lower
+  /// bound (core/geometry/separation_bound.hpp) skipped: no exact test ran for them.
+  std::uint64_t separation_culled = 0;
   /// Intra-object query: non-adjacent (f, g) pairs whose boxes passed the AABB test, how many of
-  /// those Stage II's bounds culled, how many were not evaluated again because g's search had
-  /// already evaluated (g, f), and the triangle–triangle distance evaluations that ran. With
-  /// more than one thread, the last two depend on the threads' timing (the results do not).
+  /// those Stage II's bounds culled, how many the separating-axis bound culled, how many were
+  /// not evaluated again because g's search had already evaluated (g, f), and the
+  /// triangle–triangle distance evaluations that ran. With more than one thread, the counts
+  /// after Stage II's depend on the threads' timing (the results do not).
   std::uint64_t intra_candidates = 0;
   std::uint64_t intra_voronoi_culled = 0;
+  std::uint64_t intra_separation_culled = 0;
   std::uint64_t intra_reused = 0;
   std::uint64_t intra_exact_tests = 0;
 };

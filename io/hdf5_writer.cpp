@@ -587,6 +587,8 @@ struct Hdf5ResultWriter::Impl {
     write_attribute(s, stats_where, "pns_pairs", std::uint64_t{frame.counters.object_pns_pairs});
     write_attribute(s, stats_where, "feature_pns",
                     std::uint64_t{frame.counters.feature_pns});
+    write_attribute(s, stats_where, "separation_culled",
+                    std::uint64_t{frame.counters.separation_culled});
     if (frame.intersecting_pairs)
       write_attribute(s, stats_where, "intersection_tests", std::uint64_t{frame.intersection_tests});
     if (frame.voronoi) {
@@ -607,6 +609,7 @@ struct Hdf5ResultWriter::Impl {
       write_attribute(s, stats_where, "intra_exact_tests", std::uint64_t{frame.counters.intra_exact_tests});
       write_attribute(s, stats_where, "intra_candidates", std::uint64_t{frame.counters.intra_candidates});
       write_attribute(s, stats_where, "intra_voronoi_culled", std::uint64_t{frame.counters.intra_voronoi_culled});
+      write_attribute(s, stats_where, "intra_separation_culled", std::uint64_t{frame.counters.intra_separation_culled});
       write_attribute(s, stats_where, "intra_reused", std::uint64_t{frame.counters.intra_reused});
     }
     if (frame.self_voronoi) {

@@ -207,11 +207,13 @@ Json frame_json(const FrameResult& frame, double write_ms) {
   stats["exact_tests"] = frame.counters.exact_tests;
   stats["pns_pairs"] = frame.counters.object_pns_pairs;
   stats["feature_pns"] = frame.counters.feature_pns;
+  stats["separation_culled"] = frame.counters.separation_culled;
   if (frame.intersecting_pairs) stats["intersection_tests"] = frame.intersection_tests;
   if (frame.intra) {
     stats["intra_exact_tests"] = frame.counters.intra_exact_tests;
     stats["intra_candidates"] = frame.counters.intra_candidates;
     stats["intra_voronoi_culled"] = frame.counters.intra_voronoi_culled;
+    stats["intra_separation_culled"] = frame.counters.intra_separation_culled;
     stats["intra_reused"] = frame.counters.intra_reused;
   }
   if (frame.voronoi) {

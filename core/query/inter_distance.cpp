@@ -2,6 +2,7 @@
 
 #include "core/broad_phase/object_broad_phase.hpp"
 #include "core/broad_phase/triangle_bvh.hpp"
+#include "core/geometry/separation_bound.hpp"
 #include "core/parallel.hpp"
 #include "core/timer.hpp"
 #include "core/voronoi/stage2.hpp"
@@ -93,6 +94,7 @@ void search_object(const Frame& frame, const FrameBoxes& boxes,
                    DistanceCounters& counters) {
   const auto ui = static_cast<size_t>(i);
   const auto& tb_i = boxes.triangles[ui];
+  const Object& oi = frame.objects[ui];
   const double* low_i = voronoi ? voronoi->triangle_lower[ui].data() : nullptr;
   auto bound = [&] { return std::min(u, best.distance) + slack; };
   // A probe stays useful while its triangle may still be part of a better pair.
@@ -104,6 +106,12 @@ void search_object(const Frame& frame, const FrameBoxes& boxes,
     const auto [j, ts] = scratch.probe_pair[p];
     if (voronoi && voronoi->triangle_lower[static_cast<size_t>(j)][static_cast<size_t>(to)] > bound()) return;
     if (best.contact_prunes(j, ts, to)) return;
+    // Boxes within the bound, triangles provably farther apart (separation_bound.hpp).
+    const Object& oj = frame.objects[static_cast<size_t>(j)];
+    if (separation_lower_bound(oi.triangle(ts), oj.triangle(to)) > bound()) {
+      ++counters.separation_culled;
+      return;
+    }
     consider(frame, i, ts, j, to, best);
     ++counters.exact_tests;
   };
@@ -167,6 +175,7 @@ InterDistanceOutput inter_object_distance(const Frame& frame, const FrameBoxes& 
     out.counters.object_pns_pairs += c.object_pns_pairs;
     out.counters.feature_pns += c.feature_pns;
     out.counters.exact_tests += c.exact_tests;
+    out.counters.separation_culled += c.separation_culled;
   }
   out.exact_ms = sw.elapsed_ms();
   return out;

@@ -1,6 +1,7 @@
 #include "core/query/intra_distance.hpp"
 
 #include "core/broad_phase/triangle_bvh.hpp"
+#include "core/geometry/separation_bound.hpp"
 #include "core/mesh/adjacency.hpp"
 #include "core/parallel.hpp"
 #include "core/timer.hpp"
@@ -86,10 +87,11 @@ void finish_object(IntraObjectDistance& out) {
 /// marks it done when it ends; its record then holds its final answer (every pair within its
 /// bound was evaluated, by it or offered by the other side). f's search skips a candidate g
 /// whose search is done when g's search cannot have skipped f: f's box lies within g's final
-/// bound (<= every bound g's search used) and f's D_l does not exceed it, so g evaluated the
-/// pair and offered it to f. Offers are kept by the smallest (distance, id) as from f's own
-/// evaluation (evaluate() gives both sides bitwise the same numbers), so the records end the
-/// same whichever thread evaluates which pair.
+/// bound (<= every bound g's search used) and neither f's D_l nor the pair's separation bound
+/// (the same number from both sides) exceeds it, so g evaluated the pair and offered it to f.
+/// Offers are kept by the smallest (distance, id) as from f's own evaluation (evaluate()
+/// gives both sides bitwise the same numbers), so the records end the same whichever thread
+/// evaluates which pair.
 class SharedPairs {
  public:
   explicit SharedPairs(size_t n) : current_(n), done_(n), locks_(n) {
@@ -220,13 +222,19 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
           ++c.intra_voronoi_culled;
           return;
         }
+        // Boxes within the bound, triangles provably farther apart (separation_bound.hpp).
+        const double separation = separation_lower_bound(o.triangle(f), o.triangle(g));
+        if (separation > bound()) {
+          ++c.intra_separation_culled;
+          return;
+        }
         // g's finished search already evaluated this pair and offered it to f when f's box
-        // lay within g's final bound (its last and smallest) and f's D_l did not cull it
-        // there (see SharedPairs).
+        // lay within g's final bound (its last and smallest) and neither f's D_l nor the
+        // separation bound culled it there (see SharedPairs).
         const size_t ug = static_cast<size_t>(g);
         if (pairs.done(ug)) {
           const double bg = std::min(upper_of(ug), pairs.current(ug)) + slack;
-          if (box_d2 <= bg * bg && (!lower || lower[uf] <= bg)) {
+          if (box_d2 <= bg * bg && separation <= bg && (!lower || lower[uf] <= bg)) {
             ++c.intra_reused;
             return;
           }
@@ -242,6 +250,7 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
   for (const auto& c : counters) {
     out.counters.intra_candidates += c.intra_candidates;
     out.counters.intra_voronoi_culled += c.intra_voronoi_culled;
+    out.counters.intra_separation_culled += c.intra_separation_culled;
     out.counters.intra_reused += c.intra_reused;
     out.counters.intra_exact_tests += c.intra_exact_tests;
   }

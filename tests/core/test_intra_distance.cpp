@@ -43,15 +43,16 @@ std::vector<std::pair<std::string, Frame>> scenes() {
   return out;
 }
 
-/// Every candidate pair is culled by Stage II, reused from the other triangle's search, or
-/// evaluated.
+/// Every candidate pair is culled by Stage II or by the separation bound, reused from the
+/// other triangle's search, or evaluated.
 void expect_candidates_accounted(const DistanceCounters& c, const std::string& name) {
-  EXPECT_EQ(c.intra_candidates, c.intra_voronoi_culled + c.intra_reused + c.intra_exact_tests)
+  EXPECT_EQ(c.intra_candidates, c.intra_voronoi_culled + c.intra_separation_culled +
+                                    c.intra_reused + c.intra_exact_tests)
       << name;
 }
 
 TEST(IntraDistance, EqualsBruteForceOnAllScenesAndThreadCounts) {
-  std::uint64_t reused = 0;
+  std::uint64_t reused = 0, separated = 0;
   for (const auto& [name, frame] : scenes()) {
     const auto ref = intra_object_distance_brute_force(frame);
     for (int threads : {1, 3}) {
@@ -60,10 +61,13 @@ TEST(IntraDistance, EqualsBruteForceOnAllScenesAndThreadCounts) {
       EXPECT_LE(got.counters.intra_exact_tests, ref.counters.intra_exact_tests) << name;
       expect_candidates_accounted(got.counters, name);
       reused += got.counters.intra_reused;
+      separated += got.counters.intra_separation_culled;
     }
   }
-  // Pairs evaluated from one side are offered to the other, which then skips them.
+  // Pairs evaluated from one side are offered to the other, which then skips them; pairs
+  // whose boxes are within the bound but whose triangles are not are skipped untested.
   EXPECT_GT(reused, 0u);
+  EXPECT_GT(separated, 0u);
 }
 
 TEST(IntraDistance, SortedScanReferenceEqualsBruteForce) {

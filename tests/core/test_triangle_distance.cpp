@@ -41,6 +41,7 @@
 #include "core/geometry/point_triangle.hpp"
 #include "core/geometry/predicates.hpp"
 #include "core/geometry/segment_segment.hpp"
+#include "core/geometry/separation_bound.hpp"
 #include "core/geometry/triangle_distance.hpp"
 #include "core/geometry/triangle_intersection.hpp"
 
@@ -677,6 +678,75 @@ TEST(TriangleDistance, AdversarialShapesMatchTwin) {
     }
     stats.print(offset == 0.0 ? "adversarial" : "adversarial at 1e6");
   }
+}
+
+// ---- separation lower bound ----------------------------------------------------------------
+
+/// separation_lower_bound(a, b) is symmetric bitwise and never above the twin's distance by
+/// more than its documented rounding bound 2^-48 S. Returns whether it is positive.
+bool check_separation(const Triangle& a, const Triangle& b) {
+  const double lb = separation_lower_bound(a, b), lb_swapped = separation_lower_bound(b, a);
+  EXPECT_EQ(std::memcmp(&lb, &lb_swapped, sizeof lb), 0) << "not symmetric";
+  const Real twin = twin_hull_distance(as_points(a), as_points(b)).distance;
+  EXPECT_LE(static_cast<Real>(lb), twin + static_cast<Real>(0x1p-48 * scale_of(a, b)))
+      << "lower bound " << lb << " above the distance " << static_cast<double>(twin);
+  return lb > 0;
+}
+
+TEST(SeparationBound, NeverAboveTheTwinDistance) {
+  std::mt19937_64 rng(33);
+  std::uniform_real_distribution<double> unit01(0.0, 1.0);
+  for (double offset : {0.0, 1e6}) {
+    const Vec3 shift = Vec3::Constant(offset);
+    int positive = 0;
+    for (int trial = 0; trial < 6000; ++trial) {
+      const double size = std::pow(10.0, 2 * unit01(rng) - 1);  // 0.1 .. 10
+      Triangle a = random_triangle(rng, shift, size);
+      Triangle b = random_triangle(rng, shift + random_vec(rng, 1.5 * size), size);
+      const double tiny = std::pow(10.0, -15 * unit01(rng));
+      const Vec3 n = (a[1] - a[0]).cross(a[2] - a[0]);
+      switch (trial % 8) {
+        case 0: a[2] = a[0] + 0.5 * (a[1] - a[0]); break;              // collinear
+        case 1: a[1] = a[0]; a[2] = a[0]; break;                        // a point
+        case 2: a[2] = a[0] + (1 + tiny) * (a[1] - a[0]); break;        // cap sliver
+        case 3: {                                                       // stacked, parallel
+          const Vec3 up = (tiny * size / n.norm()) * n;
+          b = {a[0] + up, a[1] + up, a[2] + up};
+          break;
+        }
+        case 4: {                                                       // nearly coplanar
+          const Vec3 in_plane = 0.3 * (a[1] - a[0]) + 0.4 * (a[2] - a[0]);
+          b = {a[0] + in_plane, a[1] + in_plane + tiny * n, a[2] + 1.2 * in_plane - tiny * n};
+          break;
+        }
+        case 5: b = a; break;                                           // identical
+        default: break;                                                 // random
+      }
+      positive += check_separation(a, b);
+      if (::testing::Test::HasFailure()) FAIL() << "offset " << offset << " trial " << trial;
+    }
+    std::printf("[ info     ] separation bound positive on %d of 6000 pairs (offset %g)\n",
+                positive, offset);
+    EXPECT_GT(positive, 1000);  // not a vacuous bound
+  }
+}
+
+TEST(SeparationBound, TightAlongTheSeparatingDirection) {
+  // Parallel triangles h apart along the normal, and triangles h apart along x with faces
+  // facing each other: the bound finds (almost) the whole gap.
+  const Triangle a{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+  for (double h : {1e-9, 1e-3, 0.5, 7.0}) {
+    const Vec3 up(0, 0, h);
+    const Triangle b{a[0] + up, a[1] + up, a[2] + up};
+    EXPECT_GE(separation_lower_bound(a, b), h * (1 - 1e-12)) << h;
+    const Triangle c{Vec3(1 + h, 0, 0), Vec3(1 + h, 1, 0), Vec3(1 + h, 0, 1)};
+    EXPECT_GT(separation_lower_bound(a, c), 0.5 * h) << h;
+  }
+  // Touching and crossing triangles: nothing to separate.
+  const Triangle touching{Vec3(1, 0, 0), Vec3(2, 0, 0), Vec3(2, 1, 0)};
+  EXPECT_LE(separation_lower_bound(a, touching), 0.0);
+  const Triangle crossing{Vec3(0.2, 0.2, -1), Vec3(0.2, 0.2, 1), Vec3(0.3, 0.1, 0)};
+  EXPECT_LE(separation_lower_bound(a, crossing), 0.0);
 }
 
 TEST(TriangleDistance, KnownFeaturesAndTieOrder) {

@@ -116,7 +116,7 @@ std::vector<FrameResult> make_frames() {
                  TriangleDistanceCase::Intersecting),
       make_inter(2, 1, 0.0, 1995, 1, Vec3(kTricky[7], kTricky[8], 1.5), Vec3(kTricky[7], kTricky[8], 1.5),
                  TriangleDistanceCase::EdgeEdge)};
-  f0.counters = {6, 1234, 567};
+  f0.counters = {6, 1234, 567, 89};
   f0.time_ms = {1.5, 0.25, 3.125, 7.0, 99.0, 12.0};
 
   FrameResult& f1 = frames[1];
@@ -264,7 +264,7 @@ TEST_F(OutputTest, JsonFramesHoldEveryValueAndDoublesRoundTripBitwise) {
 
     const json& stats = jf["stats"];
     EXPECT_EQ(keys_of(stats), (std::set<std::string>{"time_ms", "exact_tests", "pns_pairs",
-                                                     "feature_pns"}));
+                                                     "feature_pns", "separation_culled"}));
     EXPECT_EQ(keys_of(stats["time_ms"]), (std::set<std::string>{"load", "aabb", "voronoi",
                                                                 "exact", "write", "total"}));
     EXPECT_EQ(stats["time_ms"]["load"].get<double>(), f.time_ms.load);
@@ -281,6 +281,7 @@ TEST_F(OutputTest, JsonFramesHoldEveryValueAndDoublesRoundTripBitwise) {
     EXPECT_EQ(stats["exact_tests"].get<std::uint64_t>(), f.counters.exact_tests);
     EXPECT_EQ(stats["pns_pairs"].get<std::uint64_t>(), f.counters.object_pns_pairs);
     EXPECT_EQ(stats["feature_pns"].get<std::uint64_t>(), f.counters.feature_pns);
+    EXPECT_EQ(stats["separation_culled"].get<std::uint64_t>(), f.counters.separation_culled);
   }
 }
 
@@ -410,7 +411,7 @@ TEST_F(OutputTest, Hdf5FramesHoldEveryValue) {
     const std::string s = g + "/stats";
     EXPECT_EQ(h5.attribute_names(s),
               (std::vector<std::string>{"exact_tests", "feature_pns", "pns_pairs",
-                                        "time_ms_aabb", "time_ms_exact", "time_ms_load",
+                                        "separation_culled", "time_ms_aabb", "time_ms_exact", "time_ms_load",
                                         "time_ms_total", "time_ms_voronoi", "time_ms_write"}));
     EXPECT_EQ(h5.double_attribute(s, "time_ms_load"), f.time_ms.load);
     EXPECT_EQ(h5.double_attribute(s, "time_ms_aabb"), f.time_ms.aabb);
@@ -421,6 +422,7 @@ TEST_F(OutputTest, Hdf5FramesHoldEveryValue) {
     EXPECT_EQ(h5.uint_attribute(s, "exact_tests"), f.counters.exact_tests);
     EXPECT_EQ(h5.uint_attribute(s, "pns_pairs"), f.counters.object_pns_pairs);
     EXPECT_EQ(h5.uint_attribute(s, "feature_pns"), f.counters.feature_pns);
+    EXPECT_EQ(h5.uint_attribute(s, "separation_culled"), f.counters.separation_culled);
   }
 }
 

@@ -1,0 +1,44 @@
+#include "core/geometry/separation_bound.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vproxq {
+namespace {
+
+constexpr double kMinAxisSquared = 0x1p-900;
+
+Vec3 cross(const Vec3& u, const Vec3& v) {
+  return {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+}
+
+/// The gap between the projections of a and b onto w, divided by |w| (see the header).
+/// Swapping a and b, or negating w, gives bitwise the same value.
+double axis_gap(const Triangle& a, const Triangle& b, const Vec3& w) {
+  const double ww = w.squaredNorm();
+  if (!(ww >= kMinAxisSquared) || !std::isfinite(ww)) return -kInfinity;
+  double a_lo = kInfinity, a_hi = -kInfinity, b_lo = kInfinity, b_hi = -kInfinity;
+  for (size_t k = 0; k < 3; ++k) {
+    const double pa = w.dot(a[k]), pb = w.dot(b[k]);
+    a_lo = std::min(a_lo, pa);
+    a_hi = std::max(a_hi, pa);
+    b_lo = std::min(b_lo, pb);
+    b_hi = std::max(b_hi, pb);
+  }
+  return std::max(b_lo - a_hi, a_lo - b_hi) / std::sqrt(ww);
+}
+
+}  // namespace
+
+double separation_lower_bound(const Triangle& a, const Triangle& b) {
+  // Centroid line: the sums are formed in corner order for each triangle, so swapping a and
+  // b negates the axis exactly.
+  const Vec3 centres = (b[0] + b[1] + b[2]) - (a[0] + a[1] + a[2]);
+  const double g0 = axis_gap(a, b, cross(a[1] - a[0], a[2] - a[0]));
+  const double g1 = axis_gap(a, b, cross(b[1] - b[0], b[2] - b[0]));
+  // The larger of a's and b's normal gaps first, in an order that does not depend on which
+  // triangle is a, so the result is symmetric.
+  return std::max(std::max(g0, g1), axis_gap(a, b, centres));
+}
+
+}  // namespace vproxq
