@@ -565,9 +565,10 @@ std::string report_markdown(const std::vector<Scene>& scenes, const std::string&
     md << "\n## Exact tests against their floor and the paper's PNS (`vproxq-bench-pns`)\n\n";
     md << "Sums over the frames `vproxq-bench-pns` ran (the same frames as the runs above, "
           "Stage II on the CPU at the default grid). *tests*: Stage III's exact tests, whose "
-          "bound shrinks to the best distance found so far; *floor*: the pairs whose boxes (and, "
+          "bound shrinks to the best distance found so far and which skips pairs whose "
+          "separating-axis bound exceeds it; *floor*: the pairs whose boxes (and, "
           "with Stage II, both triangles' D_l) lie within the final answer, which no search "
-          "that culls by boxes and D_l can skip; *fixed*: the paper's feature-level PNS with "
+          "that culls by boxes and D_l alone can skip; *fixed*: the paper's feature-level PNS with "
           "fixed bounds (Stage I's U_i or the 2-ring bound without Stage II, D_u and D_l with "
           "it), what the paper's figure 13 counts. Reduction: off / cpu.\n\n";
     md << "| Benchmark | query | frames | tests off | tests cpu | reduction | floor off | "
