@@ -25,7 +25,9 @@ double axis_gap(const Triangle& a, const Triangle& b, const Vec3& w) {
     b_lo = std::min(b_lo, pb);
     b_hi = std::max(b_hi, pb);
   }
-  return std::max(b_lo - a_hi, a_lo - b_hi) / std::sqrt(ww);
+  const double gap = std::max(b_lo - a_hi, a_lo - b_hi) / std::sqrt(ww);
+  // Coordinates beyond ~2^300 can overflow a projection: such an axis proves nothing.
+  return std::isfinite(gap) ? gap : -kInfinity;
 }
 
 }  // namespace

@@ -17,8 +17,9 @@ namespace vproxq {
 /// |w| M; a gap, the difference of two of them, by 2 * 5.3u |w| M plus its own rounding
 /// u |gap|; dividing by the rounded sqrt(w . w) (relative error below 3u) and rounding adds
 /// 4u |gap / |w||, and |gap / |w|| <= 2 sqrt(3) M. So the result exceeds the exact distance
-/// by at most 11u M + 14u M < 2^-48 M. Axes with w . w below 2^-900 or not finite are
-/// skipped, so neither underflow nor overflow enters. Callers compare the bound with a best
+/// by at most 11u M + 14u M < 2^-48 M. Axes with w . w below 2^-900 are skipped, so underflow
+/// does not enter; nothing overflows for coordinates below 2^200 in magnitude (the range where
+/// triangle_distance is exact), and an axis whose w . w or gap is not finite is skipped. Callers compare the bound with a best
 /// distance plus a slack that covers 2^-48 M and the exact test's own rounding (for Stage III,
 /// rounding_slack()), so a skipped pair could not have been at or below that best distance.
 ///

@@ -747,6 +747,13 @@ TEST(SeparationBound, TightAlongTheSeparatingDirection) {
   EXPECT_LE(separation_lower_bound(a, touching), 0.0);
   const Triangle crossing{Vec3(0.2, 0.2, -1), Vec3(0.2, 0.2, 1), Vec3(0.3, 0.1, 0)};
   EXPECT_LE(separation_lower_bound(a, crossing), 0.0);
+  // Far outside the supported range the projections overflow: no bound, never a wrong one.
+  const double big = 1e290;
+  const Triangle huge{big * a[0], big * a[1], big * a[2]};
+  const Triangle huge_up{huge[0] + Vec3(0, 0, big), huge[1] + Vec3(0, 0, big), huge[2] + Vec3(0, 0, big)};
+  const double lb = separation_lower_bound(huge, huge_up);
+  EXPECT_FALSE(std::isnan(lb));
+  EXPECT_LE(lb, big);
 }
 
 TEST(TriangleDistance, KnownFeaturesAndTieOrder) {
