@@ -188,6 +188,8 @@ struct CcdSkipped {
 struct CcdCounters {
   std::uint64_t object_pairs = 0;     ///< object pairs (i <= j) whose swept boxes overlap
   std::uint64_t triangle_pairs = 0;   ///< candidate triangle pairs after culling
+  /// Of those, pairs shown apart for the whole step along a separating axis (no tests ran).
+  std::uint64_t separated_pairs = 0;
   std::uint64_t vf_tests = 0;         ///< elementary vertex–face tests run
   std::uint64_t ee_tests = 0;         ///< elementary edge–edge tests run
   std::uint64_t limit_hits = 0;       ///< tests reported at the kernel's box limit

@@ -90,6 +90,7 @@ Json ccd_stats_json(const CcdStepResult& c) {
   r["ee_tests"] = k.ee_tests;
   r["object_pairs"] = k.object_pairs;
   r["triangle_pairs"] = k.triangle_pairs;
+  r["separated_pairs"] = k.separated_pairs;
   r["culled_triangles"] = k.culled_triangles;
   r["limit_hits"] = k.limit_hits;
   r["vf_pairs"] = c.vf.size();

@@ -52,6 +52,61 @@ bool boxes_overlap(const AABB& a, const AABB& b) {
   return true;
 }
 
+/// A triangle's corners at the start and at the end of the step, with the axes it offers to
+/// swept_apart(): its normal at the start and the sum of its corners at the start.
+struct SweptTriangle {
+  std::array<Vec3, 3> start, end;
+  Vec3 normal, corner_sum;
+};
+
+std::vector<SweptTriangle> swept_triangles(const Object& from, const Object& to) {
+  std::vector<SweptTriangle> out(static_cast<size_t>(from.num_triangles()));
+  for (size_t t = 0; t < out.size(); ++t) {
+    const Face& f = from.topology->faces[t];
+    SweptTriangle& s = out[t];
+    for (size_t k = 0; k < 3; ++k) {
+      s.start[k] = from.positions[static_cast<size_t>(f[k])];
+      s.end[k] = to.positions[static_cast<size_t>(f[k])];
+    }
+    const Vec3 u = s.start[1] - s.start[0], v = s.start[2] - s.start[0];
+    s.normal = Vec3(u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]);
+    s.corner_sum = s.start[0] + s.start[1] + s.start[2];
+  }
+  return out;
+}
+
+/// Whether triangles a and b stay more than `gap` apart for the whole step, shown along one
+/// axis w: at time t, (smallest projection of b's corners) - (largest of a's) is a minimum of
+/// linear functions of t minus a maximum of linear functions, so it is concave in t and at
+/// least its smaller end value; when that value exceeds gap |w| at t = 0 and at t = 1 (or the
+/// same with a and b swapped), every point of b is more than `gap` from every point of a at
+/// every time. Axes: x, y, z, both normals at the start and the line through the centroids at
+/// the start (any axis is valid: the gap is compared with |w| itself). The dot products are
+/// off by a few 2^-53 |w| M (M: largest coordinate), far below the rounding slack that `gap`
+/// includes.
+bool swept_apart(const SweptTriangle& a, const SweptTriangle& b, double gap) {
+  auto apart_along = [&](const Vec3& w) {
+    // (b above a, a above b) at one time.
+    auto gaps = [&](const std::array<Vec3, 3>& pa, const std::array<Vec3, 3>& pb) {
+      double a_lo = kInfinity, a_hi = -kInfinity, b_lo = kInfinity, b_hi = -kInfinity;
+      for (size_t k = 0; k < 3; ++k) {
+        const double x = w.dot(pa[k]), y = w.dot(pb[k]);
+        a_lo = std::min(a_lo, x);
+        a_hi = std::max(a_hi, x);
+        b_lo = std::min(b_lo, y);
+        b_hi = std::max(b_hi, y);
+      }
+      return std::pair<double, double>(b_lo - a_hi, a_lo - b_hi);
+    };
+    const auto [up0, down0] = gaps(a.start, b.start);
+    const auto [up1, down1] = gaps(a.end, b.end);
+    const double d = std::max(std::min(up0, up1), std::min(down0, down1));
+    return d > 0 && d * d > gap * gap * w.squaredNorm();
+  };
+  return apart_along(Vec3::UnitX()) || apart_along(Vec3::UnitY()) || apart_along(Vec3::UnitZ()) ||
+         apart_along(a.normal) || apart_along(b.normal) || apart_along(b.corner_sum - a.corner_sum);
+}
+
 /// Results and counters of one unit of work.
 struct Hits {
   std::vector<CcdVertexFace> vf;
@@ -119,6 +174,7 @@ void add(CcdCounters& a, const CcdCounters& b) {
   a.ee_tests += b.ee_tests;
   a.limit_hits += b.limit_hits;
   a.culled_triangles += b.culled_triangles;
+  a.separated_pairs += b.separated_pairs;
 }
 
 /// Sorts the hits canonically and summarises them per object pair.
@@ -267,10 +323,12 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
 
   std::vector<TriangleBvh> bvhs(from.objects.size());
   std::vector<Ownership> owners(from.objects.size());
+  std::vector<std::vector<SweptTriangle>> swept(from.objects.size());
   parallel_for(live.size(), threads, [&](size_t k) {
     const size_t i = static_cast<size_t>(live[k]);
     bvhs[i].build(sweep.triangles[i]);
     owners[i] = ownership(*from.objects[i].topology);
+    swept[i] = swept_triangles(from.objects[i], to.objects[i]);
   });
   out.aabb_ms = sw.elapsed_ms();
   sw.restart();
@@ -300,6 +358,8 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
     const auto& tb_j = sweep.triangles[static_cast<size_t>(j)];
     const auto& vb_i = sweep.vertices[static_cast<size_t>(i)];
     const auto& vb_j = sweep.vertices[static_cast<size_t>(j)];
+    const auto& swept_i = swept[static_cast<size_t>(i)];
+    const auto& swept_j = swept[static_cast<size_t>(j)];
     // A segment's swept box: the union of its two vertices' (the same min/max as boxing all
     // four positions).
     auto edge_box = [](const std::vector<AABB>& vb, const std::array<Index, 2>& e) {
@@ -310,6 +370,9 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
     const AABB& box_j = sweep.objects[static_cast<size_t>(j)];
     const bool self = i == j;
     Hits& hits = parts[k];
+    // Separation that rules out a report: the kernel reports a pair whose primitives come
+    // within δ_k on every axis (at most sqrt(3) δmax apart), and margin >= δmax + slack.
+    const double apart_gap = 2 * sweep.margin;
 
     // Vertex v of object ov (owned by tri fv) against face g of object og.
     auto vertex_face = [&](Index ov, const std::vector<AABB>& v_boxes, Index v, Index og,
@@ -328,12 +391,17 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
         continue;
       }
       const Face& ff = oi.topology->faces[static_cast<size_t>(f)];
+      const SweptTriangle& swept_f = swept_i[static_cast<size_t>(f)];
       bvhs[static_cast<size_t>(j)].query(fb, [] { return 0.0; }, [&](Index g, double) {
         if (self && g <= f) return;  // each unordered pair once
         if (voxels && (!self && !voxels->keeps(j, g))) return;
         if (voxels && !voxels->share_voxel(i, f, j, g)) return;
         ++hits.counters.triangle_pairs;
         const Face& gf = oj.topology->faces[static_cast<size_t>(g)];
+        if (swept_apart(swept_f, swept_j[static_cast<size_t>(g)], apart_gap)) {
+          ++hits.counters.separated_pairs;
+          return;
+        }
         const AABB& gb = tb_j[static_cast<size_t>(g)];
         for (Index v : ff)
           if (own_i.vertex[static_cast<size_t>(v)] == f) vertex_face(i, vb_i, v, j, gf, g, gb);
