@@ -20,6 +20,24 @@ void TriangleBvh::build(const std::vector<AABB>& boxes) {
   for (size_t k = 0; k < order_.size(); ++k) leaf_boxes_[k] = boxes[static_cast<size_t>(order_[k])];
 }
 
+std::vector<AABB> TriangleBvh::node_unions(const std::vector<AABB>& boxes) const {
+  std::vector<AABB> out(nodes_.size());
+  // Children come after their parent in nodes_, so a reverse pass sees them first.
+  for (size_t n = nodes_.size(); n-- > 0;) {
+    const Node& node = nodes_[n];
+    AABB box;
+    if (node.count > 0) {
+      for (std::int32_t k = node.first; k < node.first + node.count; ++k)
+        box.extend(boxes[static_cast<size_t>(order_[static_cast<size_t>(k)])]);
+    } else {
+      box = out[static_cast<size_t>(node.first)];
+      box.extend(out[static_cast<size_t>(node.first) + 1]);
+    }
+    out[n] = box;
+  }
+  return out;
+}
+
 // Depth stays below 64 (the query stack size): each split halves the range, and ranges of at
 // most kLeafSize are leaves, so depth <= log2(2^31) + 1.
 void TriangleBvh::build_node(std::int32_t slot, std::int32_t begin, std::int32_t end,

@@ -25,6 +25,15 @@ class TriangleBvh {
 
   bool empty() const { return nodes_.empty(); }
 
+  /// The union, per node, of another box per triangle (`boxes[t]`, e.g. the triangles' boxes
+  /// at one end of a CCD step), indexed as the nodes are for query_overlaps().
+  std::vector<AABB> node_unions(const std::vector<AABB>& boxes) const;
+
+  /// Calls visit(t) for every triangle t whose box overlaps `query` (closed boxes), without
+  /// entering a subtree for which skip(node index) is true.
+  template <typename Skip, typename Visit>
+  void query_overlaps(const AABB& query, const Skip& skip, const Visit& visit) const;
+
   class BestFirst;
 
  private:
@@ -70,6 +79,27 @@ void TriangleBvh::query(const AABB& q, const Bound& bound, const Visit& visit) c
       stack[top++] = l;
       stack[top++] = r;
     }
+  }
+}
+
+template <typename Skip, typename Visit>
+void TriangleBvh::query_overlaps(const AABB& q, const Skip& skip, const Visit& visit) const {
+  if (nodes_.empty()) return;
+  std::int32_t stack[64];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const std::int32_t at = stack[--top];
+    const Node& node = nodes_[static_cast<size_t>(at)];
+    if (box_distance_squared(q, node.box) > 0.0 || skip(at)) continue;
+    if (node.count > 0) {
+      for (std::int32_t k = node.first; k < node.first + node.count; ++k)
+        if (box_distance_squared(q, leaf_boxes_[static_cast<size_t>(k)]) == 0.0)
+          visit(order_[static_cast<size_t>(k)]);
+      continue;
+    }
+    stack[top++] = node.first + 1;
+    stack[top++] = node.first;
   }
 }
 

@@ -107,6 +107,40 @@ bool swept_apart(const SweptTriangle& a, const SweptTriangle& b, double gap) {
          apart_along(a.normal) || apart_along(b.normal) || apart_along(b.corner_sum - a.corner_sum);
 }
 
+/// Per object: each triangle's box at the start and at the end of the step, and their unions
+/// over each node of the object's swept-box BVH.
+struct EndBoxes {
+  std::vector<AABB> start, end, node_start, node_end;
+
+  static EndBoxes of(const std::vector<SweptTriangle>& tris, const TriangleBvh& bvh) {
+    EndBoxes e;
+    e.start.resize(tris.size());
+    e.end.resize(tris.size());
+    for (size_t t = 0; t < tris.size(); ++t)
+      for (size_t k = 0; k < 3; ++k) {
+        e.start[t].extend(tris[t].start[k]);
+        e.end[t].extend(tris[t].end[k]);
+      }
+    e.node_start = bvh.node_unions(e.start);
+    e.node_end = bvh.node_unions(e.end);
+    return e;
+  }
+};
+
+/// Whether the points in boxes a and b (a_start, b_start at the start of the step, a_end,
+/// b_end at its end) stay more than `gap` apart for the whole step: along some axis, the same
+/// one of the two is ahead by more than `gap` at both ends. A point moving linearly has, at
+/// time t, the coordinate (1 - t) x(0) + t x(1), so the gap at t is at least the same blend of
+/// the two end gaps (the same argument as swept_apart(), with boxes).
+bool apart_at_both_ends(const AABB& a_start, const AABB& a_end, const AABB& b_start,
+                        const AABB& b_end, double gap) {
+  for (int k = 0; k < 3; ++k) {
+    if (b_start.lo[k] - a_start.hi[k] > gap && b_end.lo[k] - a_end.hi[k] > gap) return true;
+    if (a_start.lo[k] - b_start.hi[k] > gap && a_end.lo[k] - b_end.hi[k] > gap) return true;
+  }
+  return false;
+}
+
 /// Results and counters of one unit of work.
 struct Hits {
   std::vector<CcdVertexFace> vf;
@@ -324,11 +358,13 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
   std::vector<TriangleBvh> bvhs(from.objects.size());
   std::vector<Ownership> owners(from.objects.size());
   std::vector<std::vector<SweptTriangle>> swept(from.objects.size());
+  std::vector<EndBoxes> ends(from.objects.size());
   parallel_for(live.size(), threads, [&](size_t k) {
     const size_t i = static_cast<size_t>(live[k]);
     bvhs[i].build(sweep.triangles[i]);
     owners[i] = ownership(*from.objects[i].topology);
     swept[i] = swept_triangles(from.objects[i], to.objects[i]);
+    ends[i] = EndBoxes::of(swept[i], bvhs[i]);
   });
   out.aabb_ms = sw.elapsed_ms();
   sw.restart();
@@ -360,6 +396,8 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
     const auto& vb_j = sweep.vertices[static_cast<size_t>(j)];
     const auto& swept_i = swept[static_cast<size_t>(i)];
     const auto& swept_j = swept[static_cast<size_t>(j)];
+    const EndBoxes& ends_i = ends[static_cast<size_t>(i)];
+    const EndBoxes& ends_j = ends[static_cast<size_t>(j)];
     // A segment's swept box: the union of its two vertices' (the same min/max as boxing all
     // four positions).
     auto edge_box = [](const std::vector<AABB>& vb, const std::array<Index, 2>& e) {
@@ -392,7 +430,13 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
       }
       const Face& ff = oi.topology->faces[static_cast<size_t>(f)];
       const SweptTriangle& swept_f = swept_i[static_cast<size_t>(f)];
-      bvhs[static_cast<size_t>(j)].query(fb, [] { return 0.0; }, [&](Index g, double) {
+      const AABB& f_start = ends_i.start[static_cast<size_t>(f)];
+      const AABB& f_end = ends_i.end[static_cast<size_t>(f)];
+      const auto subtree_apart = [&](std::int32_t node) {
+        return apart_at_both_ends(f_start, f_end, ends_j.node_start[static_cast<size_t>(node)],
+                                  ends_j.node_end[static_cast<size_t>(node)], apart_gap);
+      };
+      bvhs[static_cast<size_t>(j)].query_overlaps(fb, subtree_apart, [&](Index g) {
         if (self && g <= f) return;  // each unordered pair once
         if (voxels && (!self && !voxels->keeps(j, g))) return;
         if (voxels && !voxels->share_voxel(i, f, j, g)) return;

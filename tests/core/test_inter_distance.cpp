@@ -111,6 +111,47 @@ TEST(InterDistance, SingleObjectAndEmptyObjectsHaveNoNearest) {
   EXPECT_EQ(got.per_object[0].nearest_object, 2);
 }
 
+TEST(TriangleBvh, QueryOverlapsSkipsOnlyWhatNodeUnionsExclude) {
+  // Two box sets per triangle: the hierarchy's own and a second (as CCD's boxes at the ends of
+  // a step). Pruning subtrees whose union of second boxes misses a second probe must still
+  // visit, once, every triangle whose first box overlaps the probe and whose second box meets
+  // the second probe, and nothing whose first box misses the probe.
+  const Frame frame = make_random_frame(11, 3, 1.0, 1);
+  const FrameBoxes boxes = FrameBoxes::compute(frame, 1);
+  const auto& first = boxes.triangles[0];
+  std::vector<AABB> second(first.size());
+  Rng rng(5);
+  for (size_t t = 0; t < first.size(); ++t) {
+    const Vec3 shift(rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5));
+    second[t] = {first[t].lo + shift, first[t].hi + shift};
+  }
+  TriangleBvh bvh;
+  bvh.build(first);
+  const std::vector<AABB> unions = bvh.node_unions(second);
+  std::uint64_t pruned_visits_saved = 0;
+  for (size_t p = 0; p < first.size(); p += 5) {
+    const AABB& probe = first[p];
+    const AABB& probe2 = second[(p * 7) % second.size()];
+    std::multiset<Index> got, all;
+    bvh.query_overlaps(probe, [&](std::int32_t node) {
+      return box_distance_squared(unions[static_cast<size_t>(node)], probe2) > 0.0;
+    }, [&](Index t) { got.insert(t); });
+    bvh.query_overlaps(probe, [](std::int32_t) { return false; }, [&](Index t) { all.insert(t); });
+    for (Index t = 0; t < static_cast<Index>(first.size()); ++t) {
+      const bool overlaps = box_distance_squared(probe, first[static_cast<size_t>(t)]) == 0.0;
+      EXPECT_EQ(all.count(t), overlaps ? 1u : 0u) << "triangle " << t;
+      if (overlaps && box_distance_squared(probe2, second[static_cast<size_t>(t)]) == 0.0) {
+        EXPECT_EQ(got.count(t), 1u) << "pruned away triangle " << t;
+      }
+      if (!overlaps) {
+        EXPECT_EQ(got.count(t), 0u) << "triangle " << t;
+      }
+    }
+    pruned_visits_saved += all.size() - got.size();
+  }
+  EXPECT_GT(pruned_visits_saved, 0u);  // the pruning did prune
+}
+
 TEST(TriangleBvhBestFirst, VisitsExactlyThePairsWithinTheBound) {
   // A random frame's objects as hierarchies, a few probes into each, and a fixed bound: the
   // search must visit every (probe, triangle) whose boxes are within the bound, once, and
