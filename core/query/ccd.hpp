@@ -7,7 +7,9 @@
 // is missing or whose topology differs is skipped for the step (CcdStepResult::skipped).
 // Stage I: swept boxes (the box of a triangle's 6 positions, widened by the culling margin
 // below), sweep-and-prune over the swept object boxes, then per object pair a BVH over the
-// swept triangle boxes gives the candidate triangle pairs. Optional Stage II
+// swept triangle boxes gives the candidate triangle pairs; a subtree or a pair that a
+// separating axis shows apart by more than twice the margin at both ends of the step (hence
+// throughout it: ccd.cpp) is skipped. Optional Stage II
 // (core/voronoi/ccd_stage2.hpp) culls them further with a voxelization of the swept prisms.
 // Stage III: the elementary tests of core/geometry/ccd.hpp, each vertex–face and edge–edge pair
 // tested once (see ccd.cpp for the ownership rule that deduplicates without a global set).
@@ -17,10 +19,12 @@
 //
 // Culling margin: the kernel may report a pair whose primitives come within its tolerance δ
 // (never more than ccd_max_tolerance() for this step's coordinates); all boxes are widened by
-// that plus rounding_slack(), so culling never removes a pair the kernel would report and the
-// results equal the brute force — with one documented exception: a test that stops at the
-// kernel's box limit (counters.limit_hits) is reported without a proximity guarantee, so brute
-// force could report such a pair where culling (correctly: it cannot collide) removed it.
+// that plus rounding_slack() (the separating-axis tests ask for twice that, as the kernel's
+// per-axis δ allows a Euclidean gap of sqrt(3) δ), so culling never removes a pair the kernel
+// would report and the results equal the brute force — with one documented exception: a
+// test that stops at the kernel's box limit (counters.limit_hits) is reported without a
+// proximity guarantee, so brute force could report such a pair where culling (correctly: it
+// cannot collide) removed it.
 #include "core/broad_phase/aabb.hpp"
 #include "core/results.hpp"
 #include "core/scene.hpp"
