@@ -17,15 +17,8 @@ Vec3 cross(const Vec3& u, const Vec3& v) {
 double axis_gap(const Triangle& a, const Triangle& b, const Vec3& w) {
   const double ww = w.squaredNorm();
   if (!(ww >= kMinAxisSquared) || !std::isfinite(ww)) return -kInfinity;
-  double a_lo = kInfinity, a_hi = -kInfinity, b_lo = kInfinity, b_hi = -kInfinity;
-  for (size_t k = 0; k < 3; ++k) {
-    const double pa = w.dot(a[k]), pb = w.dot(b[k]);
-    a_lo = std::min(a_lo, pa);
-    a_hi = std::max(a_hi, pa);
-    b_lo = std::min(b_lo, pb);
-    b_hi = std::max(b_hi, pb);
-  }
-  const double gap = std::max(b_lo - a_hi, a_lo - b_hi) / std::sqrt(ww);
+  const ProjectionGaps g = projection_gaps(a, b, w);
+  const double gap = std::max(g.b_above_a, g.a_above_b) / std::sqrt(ww);
   // Coordinates beyond ~2^300 can overflow a projection: such an axis proves nothing.
   return std::isfinite(gap) ? gap : -kInfinity;
 }

@@ -6,6 +6,25 @@
 
 namespace vproxq {
 
+/// Projections of the corners of a and b onto w (not divided by |w|): {smallest of b's minus
+/// largest of a's, smallest of a's minus largest of b's}. Both are <= 0 when the projections
+/// overlap; otherwise the positive one is their gap (divided by |w|: a lower bound on the
+/// distance between the triangles).
+struct ProjectionGaps {
+  double b_above_a, a_above_b;
+};
+inline ProjectionGaps projection_gaps(const Triangle& a, const Triangle& b, const Vec3& w) {
+  double a_lo = kInfinity, a_hi = -kInfinity, b_lo = kInfinity, b_hi = -kInfinity;
+  for (size_t k = 0; k < 3; ++k) {
+    const double pa = w.dot(a[k]), pb = w.dot(b[k]);
+    a_lo = pa < a_lo ? pa : a_lo;
+    a_hi = pa > a_hi ? pa : a_hi;
+    b_lo = pb < b_lo ? pb : b_lo;
+    b_hi = pb > b_hi ? pb : b_hi;
+  }
+  return {b_lo - a_hi, a_lo - b_hi};
+}
+
 /// A lower bound on the distance between the closed triangles a and b: the largest gap
 /// between their projections onto three axes, a's normal, b's normal and the line through
 /// their centroids (an axis of a degenerate triangle is skipped); -infinity when no axis

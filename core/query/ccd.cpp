@@ -3,6 +3,7 @@
 #include "core/broad_phase/object_broad_phase.hpp"
 #include "core/broad_phase/triangle_bvh.hpp"
 #include "core/geometry/ccd.hpp"
+#include "core/geometry/separation_bound.hpp"
 #include "core/mesh/adjacency.hpp"
 #include "core/parallel.hpp"
 #include "core/timer.hpp"
@@ -86,21 +87,9 @@ std::vector<SweptTriangle> swept_triangles(const Object& from, const Object& to)
 /// includes.
 bool swept_apart(const SweptTriangle& a, const SweptTriangle& b, double gap) {
   auto apart_along = [&](const Vec3& w) {
-    // (b above a, a above b) at one time.
-    auto gaps = [&](const std::array<Vec3, 3>& pa, const std::array<Vec3, 3>& pb) {
-      double a_lo = kInfinity, a_hi = -kInfinity, b_lo = kInfinity, b_hi = -kInfinity;
-      for (size_t k = 0; k < 3; ++k) {
-        const double x = w.dot(pa[k]), y = w.dot(pb[k]);
-        a_lo = std::min(a_lo, x);
-        a_hi = std::max(a_hi, x);
-        b_lo = std::min(b_lo, y);
-        b_hi = std::max(b_hi, y);
-      }
-      return std::pair<double, double>(b_lo - a_hi, a_lo - b_hi);
-    };
-    const auto [up0, down0] = gaps(a.start, b.start);
-    const auto [up1, down1] = gaps(a.end, b.end);
-    const double d = std::max(std::min(up0, up1), std::min(down0, down1));
+    const ProjectionGaps g0 = projection_gaps(a.start, b.start, w);
+    const ProjectionGaps g1 = projection_gaps(a.end, b.end, w);
+    const double d = std::max(std::min(g0.b_above_a, g1.b_above_a), std::min(g0.a_above_b, g1.a_above_b));
     return d > 0 && d * d > gap * gap * w.squaredNorm();
   };
   return apart_along(Vec3::UnitX()) || apart_along(Vec3::UnitY()) || apart_along(Vec3::UnitZ()) ||
