@@ -1,5 +1,6 @@
 #include "core/geometry/separation_bound.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
@@ -7,10 +8,6 @@ namespace vproxq {
 namespace {
 
 constexpr double kMinAxisSquared = 0x1p-900;
-
-Vec3 cross(const Vec3& u, const Vec3& v) {
-  return {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-}
 
 /// The gap between the projections of a and b onto w, divided by |w| (see the header).
 /// Swapping a and b, or negating w, gives bitwise the same value.
@@ -29,8 +26,8 @@ double separation_lower_bound(const Triangle& a, const Triangle& b) {
   // Centroid line: the sums are formed in corner order for each triangle, so swapping a and
   // b negates the axis exactly.
   const Vec3 centres = (b[0] + b[1] + b[2]) - (a[0] + a[1] + a[2]);
-  const double g0 = axis_gap(a, b, cross(a[1] - a[0], a[2] - a[0]));
-  const double g1 = axis_gap(a, b, cross(b[1] - b[0], b[2] - b[0]));
+  const double g0 = axis_gap(a, b, (a[1] - a[0]).cross(a[2] - a[0]));
+  const double g1 = axis_gap(a, b, (b[1] - b[0]).cross(b[2] - b[0]));
   // The larger of a's and b's normal gaps first, in an order that does not depend on which
   // triangle is a, so the result is symmetric.
   return std::max(std::max(g0, g1), axis_gap(a, b, centres));

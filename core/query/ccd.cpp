@@ -9,6 +9,7 @@
 #include "core/timer.hpp"
 #include "core/voronoi/ccd_stage2.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <map>
 #include <tuple>
@@ -69,8 +70,7 @@ std::vector<SweptTriangle> swept_triangles(const Object& from, const Object& to)
       s.start[k] = from.positions[static_cast<size_t>(f[k])];
       s.end[k] = to.positions[static_cast<size_t>(f[k])];
     }
-    const Vec3 u = s.start[1] - s.start[0], v = s.start[2] - s.start[0];
-    s.normal = Vec3(u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]);
+    s.normal = (s.start[1] - s.start[0]).cross(s.start[2] - s.start[0]);
     s.corner_sum = s.start[0] + s.start[1] + s.start[2];
   }
   return out;

@@ -14,21 +14,7 @@
 namespace vproxq {
 namespace {
 
-/// Frame k+1 for `from`: every vertex moved by a per-object drift plus a random jitter of up
-/// to `jitter`, so objects sweep into each other and fold onto themselves.
-Frame moved(const Frame& from, std::uint64_t seed, double drift, double jitter) {
-  test::Rng rng(seed);
-  Frame to;
-  to.index = from.index + 1;
-  for (const Object& o : from.objects) {
-    Object m = o;  // shares the topology pointer
-    const Vec3 d(rng.uniform(-drift, drift), rng.uniform(-drift, drift), rng.uniform(-drift, drift));
-    for (Vec3& p : m.positions)
-      p += d + Vec3(rng.uniform(-jitter, jitter), rng.uniform(-jitter, jitter), rng.uniform(-jitter, jitter));
-    to.objects.push_back(std::move(m));
-  }
-  return to;
-}
+using test::moved;
 
 void expect_same(const CcdStepResult& a, const CcdStepResult& b) {
   ASSERT_EQ(a.vf.size(), b.vf.size());

@@ -20,19 +20,7 @@
 namespace vproxq {
 namespace {
 
-Frame moved(const Frame& from, std::uint64_t seed, double drift, double jitter) {
-  test::Rng rng(seed);
-  Frame to;
-  to.index = from.index + 1;
-  for (const Object& o : from.objects) {
-    Object m = o;
-    const Vec3 d(rng.uniform(-drift, drift), rng.uniform(-drift, drift), rng.uniform(-drift, drift));
-    for (Vec3& p : m.positions)
-      p += d + Vec3(rng.uniform(-jitter, jitter), rng.uniform(-jitter, jitter), rng.uniform(-jitter, jitter));
-    to.objects.push_back(std::move(m));
-  }
-  return to;
-}
+using test::moved;
 
 TEST(CcdStage2, RowSolverEqualsVoxelByVoxelReference) {
   std::size_t marked = 0, flagged = 0;

@@ -17,36 +17,50 @@
 namespace vproxq {
 namespace {
 
-/// The box [lo, lo + size] with every face cut into an n x n grid of quads (2 triangles
-/// each), vertices shared along the box's edges: closed, faces oriented outwards.
-Object make_box(const Vec3& lo, const Vec3& size, int n, const std::string& name) {
+/// The box [lo, lo + size] with counts[k] cells along axis k, every face cut into a grid of
+/// quads (2 triangles each), vertices shared along the box's edges: faces oriented outwards.
+/// The cell (i, j) of the face (axis, side) listed in `hole` is left open, and its four
+/// corners (in the face's cyclic order) are returned in `hole_ring`; without a hole the box
+/// is closed.
+struct HoledBox {
+  Object object;
+  std::array<Index, 4> hole_ring{kNoIndex, kNoIndex, kNoIndex, kNoIndex};
+};
+HoledBox make_grid_box(const Vec3& lo, const Vec3& size, std::array<int, 3> counts,
+                       std::array<int, 4> hole = {-1, -1, -1, -1}) {
   std::map<std::array<int, 3>, Index> ids;
-  Object o;
+  HoledBox out;
+  Object& o = out.object;
   auto topo = std::make_shared<Topology>();
   auto vertex = [&](std::array<int, 3> g) {
     auto it = ids.find(g);
     if (it != ids.end()) return it->second;
     const Index id = static_cast<Index>(o.positions.size());
     Vec3 p;
-    for (int k = 0; k < 3; ++k) p[k] = lo[k] + size[k] * (static_cast<double>(g[static_cast<size_t>(k)]) / n);
+    for (int k = 0; k < 3; ++k)
+      p[k] = lo[k] + size[k] * (static_cast<double>(g[static_cast<size_t>(k)]) / counts[static_cast<size_t>(k)]);
     o.positions.push_back(p);
     ids[g] = id;
     return id;
   };
   for (int axis = 0; axis < 3; ++axis)
     for (int side = 0; side < 2; ++side) {
-      const int u = (axis + 1) % 3, v = (axis + 2) % 3;  // e_u x e_v = e_axis
-      for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) {
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      for (int i = 0; i < counts[static_cast<size_t>(u)]; ++i)
+        for (int j = 0; j < counts[static_cast<size_t>(v)]; ++j) {
           auto corner = [&](int di, int dj) {
             std::array<int, 3> g{};
-            g[static_cast<size_t>(axis)] = side * n;
+            g[static_cast<size_t>(axis)] = side * counts[static_cast<size_t>(axis)];
             g[static_cast<size_t>(u)] = i + di;
             g[static_cast<size_t>(v)] = j + dj;
             return vertex(g);
           };
           const Index a = corner(0, 0), b = corner(1, 0), c = corner(1, 1), d = corner(0, 1);
-          if (side == 1) {  // counter-clockwise in (u, v): normal +axis
+          if (hole == std::array<int, 4>{axis, side, i, j}) {
+            out.hole_ring = {a, b, c, d};
+            continue;
+          }
+          if (side == 1) {
             topo->faces.push_back({a, b, c});
             topo->faces.push_back({a, c, d});
           } else {
@@ -57,6 +71,13 @@ Object make_box(const Vec3& lo, const Vec3& size, int n, const std::string& name
     }
   topo->num_vertices = static_cast<Index>(o.positions.size());
   o.topology = topo;
+  o.name = "box";
+  return out;
+}
+
+/// make_grid_box with n cells along every axis, closed.
+Object make_box(const Vec3& lo, const Vec3& size, int n, const std::string& name) {
+  Object o = make_grid_box(lo, size, {n, n, n}).object;
   o.name = name;
   return o;
 }
@@ -449,61 +470,6 @@ TEST(PenetrationDepth, InsideVerticesAreTheWalkClosureOfBruteForceWinding) {
 // Self-intersections: one closed, consistently oriented object whose sheets overlap.
 // ---------------------------------------------------------------------------------------
 
-/// A box built like make_box with counts[k] cells along axis k; the cell (i, j) of the face
-/// (axis, side) listed in `hole` is left open, and its four corners (in the face's cyclic
-/// order) are returned in `hole_ring`.
-struct HoledBox {
-  Object object;
-  std::array<Index, 4> hole_ring{kNoIndex, kNoIndex, kNoIndex, kNoIndex};
-};
-HoledBox make_grid_box(const Vec3& lo, const Vec3& size, std::array<int, 3> counts,
-                       std::array<int, 4> hole = {-1, -1, -1, -1}) {
-  std::map<std::array<int, 3>, Index> ids;
-  HoledBox out;
-  Object& o = out.object;
-  auto topo = std::make_shared<Topology>();
-  auto vertex = [&](std::array<int, 3> g) {
-    auto it = ids.find(g);
-    if (it != ids.end()) return it->second;
-    const Index id = static_cast<Index>(o.positions.size());
-    Vec3 p;
-    for (int k = 0; k < 3; ++k)
-      p[k] = lo[k] + size[k] * (static_cast<double>(g[static_cast<size_t>(k)]) / counts[static_cast<size_t>(k)]);
-    o.positions.push_back(p);
-    ids[g] = id;
-    return id;
-  };
-  for (int axis = 0; axis < 3; ++axis)
-    for (int side = 0; side < 2; ++side) {
-      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-      for (int i = 0; i < counts[static_cast<size_t>(u)]; ++i)
-        for (int j = 0; j < counts[static_cast<size_t>(v)]; ++j) {
-          auto corner = [&](int di, int dj) {
-            std::array<int, 3> g{};
-            g[static_cast<size_t>(axis)] = side * counts[static_cast<size_t>(axis)];
-            g[static_cast<size_t>(u)] = i + di;
-            g[static_cast<size_t>(v)] = j + dj;
-            return vertex(g);
-          };
-          const Index a = corner(0, 0), b = corner(1, 0), c = corner(1, 1), d = corner(0, 1);
-          if (hole == std::array<int, 4>{axis, side, i, j}) {
-            out.hole_ring = {a, b, c, d};
-            continue;
-          }
-          if (side == 1) {
-            topo->faces.push_back({a, b, c});
-            topo->faces.push_back({a, c, d});
-          } else {
-            topo->faces.push_back({a, c, b});
-            topo->faces.push_back({a, d, c});
-          }
-        }
-    }
-  topo->num_vertices = static_cast<Index>(o.positions.size());
-  o.topology = topo;
-  o.name = "box";
-  return out;
-}
 
 /// The objects as one object (vertex ids of objects[k] shifted by the earlier vertex counts).
 Object merge(const std::vector<Object>& parts, const std::string& name) {

@@ -98,4 +98,20 @@ inline Object make_soup(Rng& rng, const Vec3& center, double extent, double size
   return o;
 }
 
+/// Frame k+1 for `from`: every vertex moved by a per-object drift plus a random jitter of up
+/// to `jitter`, so objects sweep into each other and fold onto themselves (CCD tests).
+inline Frame moved(const Frame& from, std::uint64_t seed, double drift, double jitter) {
+  Rng rng(seed);
+  Frame to;
+  to.index = from.index + 1;
+  for (const Object& o : from.objects) {
+    Object m = o;  // shares the topology pointer
+    const Vec3 d(rng.uniform(-drift, drift), rng.uniform(-drift, drift), rng.uniform(-drift, drift));
+    for (Vec3& p : m.positions)
+      p += d + Vec3(rng.uniform(-jitter, jitter), rng.uniform(-jitter, jitter), rng.uniform(-jitter, jitter));
+    to.objects.push_back(std::move(m));
+  }
+  return to;
+}
+
 }  // namespace vproxq::test
