@@ -89,6 +89,91 @@ inline void corner_values(Kind kind, const double x[4][3], const Box& b, double 
   }
 }
 
+// ---- Exclusion along other directions ------------------------------------------------------
+//
+// Over a box, F is a trilinear blend of its 8 corner values with non-negative weights summing
+// to 1 (affine in each parameter separately), so F takes values only in the convex hull of
+// the exact corner values F_c. For any fixed vector w, w . F >= min_c w . F_c over the box:
+// if every corner has w . F_c > 0 (or every one < 0), the box holds no root. The coordinate
+// axes are the test above; near-degenerate queries (a vertex sliding along a face, edges
+// that become parallel or coincide at the end of the step) leave all three coordinate ranges
+// straddling 0 until boxes are tiny, and there a few directions taken from the box itself
+// exclude it at once:
+//   w0: the sum of the corners (where the box's image lies, seen from the origin);
+//   w1: w0 without its component along the box's largest spread (the change of F along the
+//       parameter that moves it most), which is what separates a long thin image;
+//   w2: the cross product of the two largest spreads, the normal of a flat image (the
+//       triangle's normal for vertex–face, ea x eb for edge–edge, on small boxes).
+// Any w is valid (the directions only propose), so the test is done in rounded arithmetic
+// with its own bound. Rounding: w is scaled to max |w_k| = 1 (no overflow: |F| <= 6M <=
+// 2^1003). The computed corners F̂_c are within ε_k of the exact F_c per coordinate (above),
+// so |w . F̂_c - w . F_c| <= Σ |w_k| ε_k; the rounded dot product fl(w . F̂_c) is within
+// γ_3 Σ |w_k| |F̂_ck| <= 2^-51 Σ |w_k| Fmax_k of w . F̂_c (Fmax_k = the largest |F̂_ck|), plus
+// at most 2^-1073 of underflow. A box is excluded when every fl(w . F̂_c) exceeds
+// E = (Σ |w_k| (ε_k + 2^-51 Fmax_k)) (1 + 2^-40) + 2^-1070 (the factor covers the few
+// roundings of E itself), or every one is below -E.
+constexpr double kDotRounding = 0x1p-51;
+
+/// Scales w to max |w_k| = 1 and returns the old max |w_k|; 0 if w is zero or not finite (no
+/// direction).
+inline double unit_max(double w[3]) {
+  const double m = std::max({std::abs(w[0]), std::abs(w[1]), std::abs(w[2])});
+  if (!(m > 0) || !std::isfinite(m)) return 0;
+  for (int k = 0; k < 3; ++k) w[k] /= m;
+  return m;
+}
+
+/// Whether w (scaled by unit_max) separates every corner of F from 0 (see above).
+inline bool excludes(const double w[3], const double F[8][3], const double eps[3], const double fmax[3]) {
+  double bound = 0;
+  for (int k = 0; k < 3; ++k) bound += std::abs(w[k]) * (eps[k] + kDotRounding * fmax[k]);
+  bound = bound * (1 + 0x1p-40) + 0x1p-1070;
+  double lo = kInfinity, hi = -kInfinity;
+  for (int c = 0; c < 8; ++c) {
+    const double p = (w[0] * F[c][0] + w[1] * F[c][1]) + w[2] * F[c][2];
+    lo = std::min(lo, p);
+    hi = std::max(hi, p);
+  }
+  return lo > bound || hi < -bound;
+}
+
+/// The directional tests w0, w1, w2 above on a box's corner values.
+bool excluded_along_box_directions(const double F[8][3], const double eps[3], const double fmax[3]) {
+  double w0[3] = {0, 0, 0};
+  for (int c = 0; c < 8; ++c)
+    for (int k = 0; k < 3; ++k) w0[k] += F[c][k];
+  if (!(unit_max(w0) > 0)) return false;
+  if (excludes(w0, F, eps, fmax)) return true;
+  // Spreads: the sum over the 4 corner pairs that differ in one parameter of their change,
+  // scaled to max |component| = 1; size[dim] is their max |component| before (0: none).
+  double spread[3][3];
+  double size[3];
+  for (int dim = 0; dim < 3; ++dim) {
+    const int bit = 1 << dim;
+    for (int k = 0; k < 3; ++k) spread[dim][k] = 0;
+    for (int c = 0; c < 8; ++c) {
+      if (c & bit) continue;
+      for (int k = 0; k < 3; ++k) spread[dim][k] += F[c | bit][k] - F[c][k];
+    }
+    size[dim] = unit_max(spread[dim]);
+  }
+  int first = 0;
+  for (int dim = 1; dim < 3; ++dim)
+    if (size[dim] > size[first]) first = dim;
+  if (!(size[first] > 0)) return false;
+  int second = first == 0 ? 1 : 0;
+  for (int dim = 0; dim < 3; ++dim)
+    if (dim != first && size[dim] > size[second]) second = dim;
+  const double* a = spread[first];
+  const double along = (w0[0] * a[0] + w0[1] * a[1] + w0[2] * a[2]) / (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+  double w1[3] = {w0[0] - along * a[0], w0[1] - along * a[1], w0[2] - along * a[2]};
+  if (unit_max(w1) > 0 && excludes(w1, F, eps, fmax)) return true;
+  if (!(size[second] > 0)) return false;
+  const double* b = spread[second];
+  double w2[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+  return unit_max(w2) > 0 && excludes(w2, F, eps, fmax);
+}
+
 CcdResult conservative_hit(double t, std::uint32_t boxes) {
   CcdResult r;
   r.collides = true;
@@ -154,6 +239,7 @@ CcdResult solve(Kind kind, const std::array<Vec3, 4>& start, const std::array<Ve
 
     bool inside = true;
     bool excluded = false;
+    double fmax[3];
     for (int k = 0; k < 3 && !excluded; ++k) {
       double lo = F[0][k], hi = F[0][k];
       for (int c = 1; c < 8; ++c) {
@@ -162,8 +248,10 @@ CcdResult solve(Kind kind, const std::array<Vec3, 4>& start, const std::array<Ve
       }
       if (lo > q.eps[k] || hi < -q.eps[k]) excluded = true;
       if (hi + q.eps[k] > q.delta[k] || lo - q.eps[k] < -q.delta[k]) inside = false;
+      fmax[k] = std::max(-lo, hi);
     }
     if (excluded) continue;
+    if (excluded_along_box_directions(F, q.eps, fmax)) continue;
     if (inside) {
       best = b.t0;  // b.t0 < best, checked above
       continue;

@@ -10,7 +10,10 @@
 // takes its extreme values at the 8 box corners. The finder evaluates F at the corners in
 // double precision, widens the corner range by a derived rounding bound ε (ccd.cpp), and
 // discards a box whose widened range misses 0 in some coordinate: that box provably holds no
-// root. Boxes are bisected depth first, earlier t first; a box whose whole widened range lies
+// root. Since F over a box lies in the convex hull of its corner values, the same holds along
+// any direction: a few directions taken from the corners (ccd.cpp) discard the boxes of
+// near-degenerate queries (sliding contact, edges that become parallel or coincide) that no
+// coordinate range can, long before the boxes are tiny. Boxes are bisected depth first, earlier t first; a box whose whole widened range lies
 // within the tolerance cube [-δ, δ]^3 is a hit, and the reported TOI is the smallest lower
 // t of the hits (boxes that start later than the best hit so far are dropped unexamined).
 //

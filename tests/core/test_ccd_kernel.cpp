@@ -7,6 +7,7 @@
 #include "core/geometry/ccd.hpp"
 #include "support/random_scene.hpp"
 
+#include <Eigen/Geometry>
 #include <array>
 
 namespace vproxq {
@@ -163,6 +164,87 @@ TEST(CcdKernel, DegenerateEdge) {
   EXPECT_FALSE(edge_edge_ccd(P4{a0, a1, Vec3(0.3, 0.01, 1), Vec3(0.3, 0.01, 1)},
                              P4{a0, a1, Vec3(0.3, 0.01, -1), Vec3(0.3, 0.01, -1)})
                    .collides);
+}
+
+// Near-degenerate queries, in a rotated frame so that no coordinate axis separates them: the
+// coordinate ranges of F straddle 0 until the parameter boxes are tiny, and only the
+// directional exclusion (ccd.cpp) keeps these within a few thousand boxes. Each of them ran
+// to the box limit (2^17) without it, on the breaking and cloth-funnel benchmark scenes.
+TEST(CcdKernel, NearDegenerateQueriesAreDecidedWellBeforeTheBoxLimit) {
+  const Eigen::Matrix3d rot = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  auto rotated = [&](P4 p) {
+    for (Vec3& x : p) x = rot * x + Vec3(0.3, -0.2, 0.1);
+    return p;
+  };
+  constexpr std::uint32_t kFewBoxes = 10000;
+
+  // Two edges that come from opposite sides and coincide exactly at t = 1 (fractured pieces
+  // meeting along a shared edge): a line of roots at t = 1, none before.
+  const P4 meet{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 0, 0), Vec3(1, 0, 0)};
+  const CcdResult c = edge_edge_ccd(rotated(P4{Vec3(0, 0.5, 2), Vec3(1, 0.8, 2.5), Vec3(0.2, -1, -2), Vec3(1.3, -0.6, -1)}),
+                                    rotated(meet));
+  ASSERT_TRUE(c.collides);
+  EXPECT_LE(c.toi, 1.0);
+  EXPECT_GE(c.toi, 1.0 - kToiSlack);
+  EXPECT_FALSE(c.hit_limit);
+  EXPECT_LT(c.boxes, kFewBoxes);
+
+  // Nearly parallel edges (angle 1e-4) passing each other 5e-5 apart (about 30 δ): no contact.
+  const CcdResult p = edge_edge_ccd(rotated(P4{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(-0.3, 5e-5, 0.6), Vec3(0.7, 5e-5, 0.6001)}),
+                                    rotated(P4{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.3, 5e-5, -0.6), Vec3(1.3, 5e-5, -0.5999)}));
+  EXPECT_FALSE(p.collides);
+  EXPECT_FALSE(p.hit_limit);
+  EXPECT_LT(p.boxes, kFewBoxes);
+
+  // A vertex sliding across a face 1e-4 above it (far above δ ~ 1e-6): no contact.
+  const Vec3 a(0, 0, 0), b(1, 0, 0), cc(0, 1, 0);
+  const CcdResult v = vertex_face_ccd(rotated(P4{Vec3(-0.5, 0.2, 1e-4), a, b, cc}), rotated(P4{Vec3(1.5, 0.3, 1e-4), a, b, cc}));
+  EXPECT_FALSE(v.collides);
+  EXPECT_FALSE(v.hit_limit);
+  EXPECT_LT(v.boxes, kFewBoxes);
+}
+
+// The directional exclusion must never remove a root: random queries that touch at a chosen
+// time t* in the configurations it is meant for, all in a random rotated frame: coplanar
+// vertex–face motion (everything in one plane), coplanar crossing edges, and collinear edges
+// (everything on one line). As in RandomCollidingQueries, the positions at t* coincide up to
+// rounding, so the answer must be "collides" with toi <= t*.
+TEST(CcdKernel, RandomDegenerateCollidingQueries) {
+  test::Rng rng(4242);
+  int limit_hits = 0;
+  for (int q = 0; q < 3000; ++q) {
+    const int kind = q % 3;  // 0: coplanar vertex-face, 1: coplanar edges, 2: collinear edges
+    const double ts = q % 10 == 0 ? 0.0 : q % 10 == 1 ? 1.0 : rng.uniform(0, 1);
+    // Points in the plane z = 0 (kind 0, 1) or on the x axis (kind 2).
+    auto rnd = [&] { return Vec3(rng.uniform(-1, 1), kind == 2 ? 0.0 : rng.uniform(-1, 1), 0.0); };
+    P4 s{rnd(), rnd(), rnd(), rnd()}, e{rnd(), rnd(), rnd(), rnd()};
+    auto at = [&](int i) { return Vec3(s[static_cast<size_t>(i)] + ts * (e[static_cast<size_t>(i)] - s[static_cast<size_t>(i)])); };
+    double u = rng.uniform(0, 1), v = rng.uniform(0, 1);
+    if (kind == 0 && u + v > 1) {
+      u = 1 - u;
+      v = 1 - v;
+    }
+    Vec3 shift;
+    if (kind == 0) {
+      shift = at(1) + u * (at(2) - at(1)) + v * (at(3) - at(1)) - at(0);
+    } else {
+      shift = at(2) + v * (at(3) - at(2)) - (at(0) + u * (at(1) - at(0)));
+    }
+    for (int i = 0; i < (kind == 0 ? 1 : 2); ++i) {
+      s[static_cast<size_t>(i)] += shift;
+      e[static_cast<size_t>(i)] += shift;
+    }
+    const Eigen::Matrix3d rot =
+        Eigen::AngleAxisd(rng.uniform(0, 3), Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)).normalized())
+            .toRotationMatrix();
+    for (P4* p : {&s, &e})
+      for (Vec3& x : *p) x = rot * x;
+    const CcdResult r = kind == 0 ? vertex_face_ccd(s, e) : edge_edge_ccd(s, e);
+    ASSERT_TRUE(r.collides) << "query " << q << " kind " << kind << " t* " << ts;
+    EXPECT_LE(r.toi, ts + 1e-9) << "query " << q;
+    limit_hits += r.hit_limit;
+  }
+  std::printf("[          ] degenerate colliding queries: 3000, box-limit hits: %d\n", limit_hits);
 }
 
 TEST(CcdKernel, NonFiniteInputIsConservative) {
