@@ -29,6 +29,14 @@ struct AABB {
   }
 };
 
+/// Whether the closed boxes a and b overlap (touching included): exact comparisons, and
+/// cheaper than box_distance_squared() == 0, which a gap below ~1e-154 also passes (its
+/// square underflows).
+inline bool boxes_overlap(const AABB& a, const AABB& b) {
+  return a.lo.x() <= b.hi.x() && b.lo.x() <= a.hi.x() && a.lo.y() <= b.hi.y() && b.lo.y() <= a.hi.y() &&
+         a.lo.z() <= b.hi.z() && b.lo.z() <= a.hi.z();
+}
+
 /// Squared distance between two boxes (0 when they overlap): a lower bound for the squared
 /// distance between anything inside them.
 inline double box_distance_squared(const AABB& a, const AABB& b) {

@@ -91,11 +91,10 @@ void TriangleBvh::query_overlaps(const AABB& q, const Skip& skip, const Visit& v
   while (top > 0) {
     const std::int32_t at = stack[--top];
     const Node& node = nodes_[static_cast<size_t>(at)];
-    if (box_distance_squared(q, node.box) > 0.0 || skip(at)) continue;
+    if (!boxes_overlap(q, node.box) || skip(at)) continue;
     if (node.count > 0) {
       for (std::int32_t k = node.first; k < node.first + node.count; ++k)
-        if (box_distance_squared(q, leaf_boxes_[static_cast<size_t>(k)]) == 0.0)
-          visit(order_[static_cast<size_t>(k)]);
+        if (boxes_overlap(q, leaf_boxes_[static_cast<size_t>(k)])) visit(order_[static_cast<size_t>(k)]);
       continue;
     }
     stack[top++] = node.first + 1;

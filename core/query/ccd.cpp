@@ -48,12 +48,6 @@ bool share_endpoint(const std::array<Index, 2>& a, const std::array<Index, 2>& b
   return a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1];
 }
 
-bool boxes_overlap(const AABB& a, const AABB& b) {
-  for (int k = 0; k < 3; ++k)
-    if (a.lo[k] > b.hi[k] || b.lo[k] > a.hi[k]) return false;
-  return true;
-}
-
 /// A triangle's corners at the start and at the end of the step, with the axes it offers to
 /// swept_apart(): its normal at the start and the sum of its corners at the start.
 struct SweptTriangle {

@@ -13,9 +13,6 @@
 namespace vproxq {
 namespace {
 
-/// Closed boxes overlap (touching included). Exact: a - b > 0 iff a > b for doubles.
-bool boxes_overlap(const AABB& a, const AABB& b) { return box_distance_squared(a, b) == 0.0; }
-
 /// Object pairs (i < j) whose boxes overlap, ascending: sweep and prune along x.
 std::vector<std::pair<Index, Index>> overlapping_objects(const FrameBoxes& boxes) {
   const auto n = static_cast<Index>(boxes.objects.size());
@@ -83,7 +80,7 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
   const VoronoiBounds* voronoi = opts.voronoi;
   std::vector<std::vector<IntersectingPair>> found(items.size());
   std::vector<std::uint64_t> tests(items.size(), 0);
-  const auto zero = [] { return 0.0; };  // box overlap only
+  const auto no_skip = [](std::int32_t) { return false; };
   parallel_for(items.size(), threads, [&](size_t k) {
     const WorkItem& w = items[k];
     const Object& oi = frame.objects[static_cast<size_t>(w.i)];
@@ -93,7 +90,7 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
     if (w.i == w.j) {
       for (Index f = w.first; f < w.last; ++f) {
         const Face& ff = oi.topology->faces[static_cast<size_t>(f)];
-        boxes.bvh(static_cast<size_t>(w.i)).query(tb_i[static_cast<size_t>(f)], zero, [&](Index g, double) {
+        boxes.bvh(static_cast<size_t>(w.i)).query_overlaps(tb_i[static_cast<size_t>(f)], no_skip, [&](Index g) {
           if (g <= f || Adjacency::share_vertex(ff, oi.topology->faces[static_cast<size_t>(g)])) return;
           ++tests[k];
           if (triangles_intersect(oi.triangle(f), oi.triangle(g))) hits.push_back({w.i, f, w.i, g});
@@ -109,7 +106,7 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
         if (low_i && low_i[f] > 0.0) continue;
         const AABB& bf = tb_i[static_cast<size_t>(f)];
         if (!boxes_overlap(bf, box_j)) continue;
-        boxes.bvh(static_cast<size_t>(w.j)).query(bf, zero, [&](Index g, double) {
+        boxes.bvh(static_cast<size_t>(w.j)).query_overlaps(bf, no_skip, [&](Index g) {
           if (low_j && low_j[g] > 0.0) return;
           ++tests[k];
           if (triangles_intersect(oi.triangle(f), oj.triangle(g))) hits.push_back({w.i, f, w.j, g});
