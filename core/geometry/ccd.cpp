@@ -56,6 +56,7 @@ struct Query {
   double d[4][3];   ///< fl(end - start)
   double eps[3];
   double delta[3];
+  double inv_delta[3];  ///< 1 / delta, rounded (only for choosing the side to split)
 };
 
 /// The 4 points at time t, rounded exactly as the derivation above assumes.
@@ -119,7 +120,8 @@ constexpr double kDotRounding = 0x1p-51;
 inline double unit_max(double w[3]) {
   const double m = std::max({std::abs(w[0]), std::abs(w[1]), std::abs(w[2])});
   if (!(m > 0) || !std::isfinite(m)) return 0;
-  for (int k = 0; k < 3; ++k) w[k] /= m;
+  const double inv = 1 / m;  // rounded: max |w_k| ends within 2u of 1, which is all we need
+  for (int k = 0; k < 3; ++k) w[k] *= inv;
   return m;
 }
 
@@ -202,8 +204,10 @@ CcdResult solve(Kind kind, const std::array<Vec3, 4>& start, const std::array<Ve
     q.eps[k] = m * kEpsilonFactor + kUnderflowSlack;
     extent = std::max(extent, hi - lo);
   }
-  for (int k = 0; k < 3; ++k)
+  for (int k = 0; k < 3; ++k) {
     q.delta[k] = std::max(kCcdRelativeTolerance * extent, kDeltaOverEpsilon * q.eps[k]);
+    q.inv_delta[k] = 1 / q.delta[k];
+  }
 
   // Depth-first search with pruning. `best` is the smallest t0 of the boxes found within δ
   // so far; a box with t0 >= best cannot improve the answer and is dropped. Invariant: every
@@ -273,7 +277,7 @@ CcdResult solve(Kind kind, const std::array<Vec3, 4>& start, const std::array<Ve
         for (int c = 0; c < 8; ++c) {
           if (c & bit) continue;
           for (int k = 0; k < 3; ++k)
-            var = std::max(var, std::abs(F[c | bit][k] - F[c][k]) / q.delta[k]);
+            var = std::max(var, std::abs(F[c | bit][k] - F[c][k]) * q.inv_delta[k]);
         }
         var *= 1 + width[dim];  // ties (no variation) go to the wider side
         if (var > best_var) {
