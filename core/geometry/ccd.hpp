@@ -13,9 +13,10 @@
 // root. Since F over a box lies in the convex hull of its corner values, the same holds along
 // any direction: a few directions taken from the corners (ccd.cpp) discard the boxes of
 // near-degenerate queries (sliding contact, edges that become parallel or coincide) that no
-// coordinate range can, long before the boxes are tiny. Boxes are bisected depth first, earlier t first; a box whose whole widened range lies
-// within the tolerance cube [-δ, δ]^3 is a hit, and the reported TOI is the smallest lower
-// t of the hits (boxes that start later than the best hit so far are dropped unexamined).
+// coordinate range can, long before the boxes are tiny. Boxes are bisected depth first,
+// earlier t first; a box whose whole widened range lies within the tolerance cube [-δ, δ]^3
+// is a hit, and the reported TOI is the smallest lower t of the hits (boxes that start later
+// than the best hit so far are dropped unexamined).
 //
 // Guarantee (no false negatives): if the primitives touch at some time t* in [0, 1]
 // (including contact at t = 0 or t = 1, coplanar and parallel motion, degenerate triangles and
