@@ -63,11 +63,12 @@ struct StageGrid {
       lo[k] = cell_of(box.lo[k] - grid.origin[k] - voxel_slack);
       hi[k] = cell_of(box.hi[k] - grid.origin[k] + voxel_slack);
     }
+    const TriangleBoxTester tester(rel, half);
     for (std::int32_t z = lo[2]; z <= hi[2]; ++z)
       for (std::int32_t y = lo[1]; y <= hi[1]; ++y)
         for (std::int32_t x = lo[0]; x <= hi[0]; ++x) {
           const Vec3 c = grid.cell * Vec3(x + 0.5, y + 0.5, z + 0.5);
-          if (!triangle_box_overlap(rel, c, half)) continue;
+          if (!tester.overlaps(c)) continue;
           visit(x + std::int64_t{grid.dims[0]} * (y + std::int64_t{grid.dims[1]} * z));
         }
   }
