@@ -35,8 +35,12 @@ struct GatherTriangles {
   std::vector<PreparedTriangle> prepared;
   std::vector<Vec3> box_lo, box_hi;
   std::vector<std::array<std::int32_t, 3>> first_bin;
+  /// With `entry_masks`, per entry of in.bin_tris: bit a set when the entry's bin is its
+  /// triangle's first bin along axis a, so that for_each_in() decides a first visit from the
+  /// bin list alone (a sequential read instead of a lookup of first_bin per entry).
+  std::vector<std::uint8_t> entry_starts;
 
-  GatherTriangles(const DvdInput& in, int threads) {
+  GatherTriangles(const DvdInput& in, int threads, bool entry_masks = false) {
     const std::size_t n = in.tri_site.size();
     prepared.resize(n);
     box_lo.resize(n);
@@ -50,6 +54,18 @@ struct GatherTriangles {
       box_hi[t] = tri[0].cwiseMax(tri[1]).cwiseMax(tri[2]);
       first_bin[t] = bins_overlapping(in, box_lo[t], box_hi[t]).lo;
     });
+    if (!entry_masks) return;
+    entry_starts.resize(in.bin_tris.size());
+    const std::size_t bx = static_cast<std::size_t>(in.bin_dims[0]), by = static_cast<std::size_t>(in.bin_dims[1]);
+    parallel_for(in.bin_offsets.size() - 1, threads, [&](std::size_t b) {
+      const std::array<std::int32_t, 3> here{static_cast<std::int32_t>(b % bx), static_cast<std::int32_t>((b / bx) % by),
+                                             static_cast<std::int32_t>(b / (bx * by))};
+      for (std::int32_t i = in.bin_offsets[b]; i < in.bin_offsets[b + 1]; ++i) {
+        const auto& first = first_bin[static_cast<std::size_t>(in.bin_tris[static_cast<std::size_t>(i)])];
+        entry_starts[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(
+            (first[0] == here[0]) | (first[1] == here[1]) << 1 | (first[2] == here[2]) << 2);
+      }
+    });
   }
 
   /// Squared distance from q to triangle t's bounding box.
@@ -57,22 +73,22 @@ struct GatherTriangles {
     return (box_lo[t] - q).cwiseMax(q - box_hi[t]).cwiseMax(0.0).squaredNorm();
   }
 
-  /// Calls visit(t) once for every triangle listed in the bins of `range`.
+  /// Calls visit(t) once for every triangle listed in the bins of `range`: in the first bin
+  /// of the range holding it, the bin whose coordinate along each axis is the larger of the
+  /// range's start and the triangle's first bin. Needs the entry masks.
   template <typename Visit>
   void for_each_in(const DvdInput& in, const BinRange& range, const Visit& visit) const {
     for (std::int32_t bz = range.lo[2]; bz <= range.hi[2]; ++bz)
       for (std::int32_t by = range.lo[1]; by <= range.hi[1]; ++by)
         for (std::int32_t bx = range.lo[0]; bx <= range.hi[0]; ++bx) {
           const auto b = static_cast<std::size_t>(bin_id(in, bx, by, bz));
-          const std::array<std::int32_t, 3> here{bx, by, bz};
-          for (std::int32_t i = in.bin_offsets[b]; i < in.bin_offsets[b + 1]; ++i) {
-            const auto t = static_cast<std::size_t>(in.bin_tris[static_cast<std::size_t>(i)]);
-            // Visit a triangle once: in the first visited bin of its own range.
-            bool first_visit = true;
-            for (std::size_t a = 0; a < 3; ++a)
-              first_visit = first_visit && std::max(first_bin[t][a], range.lo[a]) == here[a];
-            if (first_visit) visit(t);
-          }
+          // Along an axis where this bin is past the range's start, only triangles whose
+          // first bin it is are visited here (the others were visited in an earlier bin).
+          const auto need = static_cast<std::uint8_t>((bx > range.lo[0]) | (by > range.lo[1]) << 1 |
+                                                      (bz > range.lo[2]) << 2);
+          for (std::int32_t i = in.bin_offsets[b]; i < in.bin_offsets[b + 1]; ++i)
+            if ((entry_starts[static_cast<std::size_t>(i)] & need) == need)
+              visit(static_cast<std::size_t>(in.bin_tris[static_cast<std::size_t>(i)]));
         }
   }
 };

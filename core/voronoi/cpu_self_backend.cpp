@@ -41,7 +41,7 @@ class CpuSelfVoronoiBackend final : public SelfVoronoiBackend {
     const DvdInput& in = self.dvd;
     const std::size_t sample_count = in.voxels.size();
 
-    const GatherTriangles tris(in, threads_);
+    const GatherTriangles tris(in, threads_, /*entry_masks=*/true);
 
     // Runs of equal voxels: [starts[r], starts[r + 1]).
     std::vector<std::size_t> starts;
