@@ -63,8 +63,11 @@ int guarded(F&& body) {
     return report("input error", e, exit_code::kInput);
   } catch (const RuntimeError& e) {
     return report("error", e, exit_code::kRuntime);
-  } catch (const std::bad_alloc& e) {
-    return report("error", e, exit_code::kRuntime);
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr,
+                 "vproxq: error: out of memory (std::bad_alloc); with --voronoi=cpu or gpu a coarser "
+                 "--grid needs less\n");
+    return exit_code::kRuntime;
   } catch (const std::exception& e) {
     return report("error", e, exit_code::kRuntime);
   }
@@ -162,9 +165,9 @@ int cli_main(int argc, char** argv) {
                  "auto (gpu on a hardware GPU, else cpu). Default: off. Results are identical.")
       ->check(CLI::IsMember({"off", "cpu", "gpu", "auto"}));
   app.add_option("--grid", config.grid,
-                 "Voronoi grid: cells along the longest axis (default: scene's \"grid\", else "
-                 "4*cbrt(triangles) clamped to [32, 256])")
-      ->check(CLI::PositiveNumber);
+                 "Voronoi grid: cells along the longest axis, at most " + std::to_string(kMaxGridResolution) +
+                     " (default: scene's \"grid\", else 4*cbrt(triangles) clamped to [32, 256])")
+      ->check(CLI::Range(1, kMaxGridResolution));
   app.add_option("--device", config.device, "EGL device index for --voronoi=gpu (default: first hardware device)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--threads", config.threads, "worker threads (default 0: all cores)")

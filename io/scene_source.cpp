@@ -388,7 +388,8 @@ void parse_scene_json(SceneImpl& s) {
     }
   }
   if (root.contains("grid")) {
-    s.grid = static_cast<int>(p.integer(root["grid"], "grid", 1, INT_MAX, "a positive integer"));
+    const std::string what = "an integer in [1, " + std::to_string(kMaxGridResolution) + "]";
+    s.grid = static_cast<int>(p.integer(root["grid"], "grid", 1, kMaxGridResolution, what.c_str()));
   }
 
   if (root.contains("static")) {

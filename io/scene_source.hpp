@@ -22,6 +22,12 @@ std::string query_names_list();
 /// How a frame file splits into objects (scene.json "objects").
 enum class ObjectSplit { Meshes, Components };
 
+/// Largest Voronoi grid resolution (cells along the longest axis) that the scene's "grid" and
+/// --grid accept: Stage II's memory grows with the number of marked voxels, which grows with
+/// the square of the resolution (the cube for the CCD grid's bound), and 4096 already needs
+/// gigabytes on small scenes.
+inline constexpr int kMaxGridResolution = 4096;
+
 /// A parsed scene. Frames are read from disk only in load_frame(), so memory does not grow
 /// with the number of frames. Static geometry is read once and shared by every frame.
 class SceneSource {
@@ -34,7 +40,8 @@ class SceneSource {
   const std::string& name() const;
   const std::filesystem::path& path() const;
   std::size_t frame_count() const;
-  /// scene.json "queries" (empty when absent) and "grid" (nullopt when absent).
+  /// scene.json "queries" (empty when absent) and "grid" (nullopt when absent; at most
+  /// kMaxGridResolution).
   const std::vector<std::string>& queries() const;
   std::optional<int> grid() const;
   ObjectSplit split() const;

@@ -33,6 +33,17 @@ BinRange bins_within(const DvdInput& in, const Vec3& point, double radius) {
   return bins_overlapping(in, point - r, point + r);
 }
 
+std::int32_t bin_size_for(const VoronoiGrid& grid, std::int32_t preferred) {
+  auto bins = [&](std::int64_t side) {
+    std::int64_t n = 1;
+    for (const std::int32_t d : grid.dims) n *= (std::int64_t{d} + side - 1) / side;
+    return n;
+  };
+  std::int64_t side = std::max<std::int32_t>(preferred, 1);
+  while (bins(side) > kMaxBins) ++side;
+  return static_cast<std::int32_t>(side);
+}
+
 void bin_triangles(DvdInput& in, std::int32_t bin_size) {
   if (bin_size < 1) {
     throw std::invalid_argument("bin_triangles: bin_size " + std::to_string(bin_size) +

@@ -23,6 +23,14 @@ namespace vproxq {
 /// numbers per triangle, or when the listing would exceed 2^31 - 1 entries.
 void bin_triangles(DvdInput& in, std::int32_t bin_size);
 
+/// Bins at most (2^24 bins: the CSR offsets are dense, 12 bytes per bin while binning).
+inline constexpr std::int64_t kMaxBins = std::int64_t{1} << 24;
+
+/// The bin side (voxels) to use for `grid`: `preferred`, or the smallest larger side that keeps
+/// the bin count within kMaxBins (fine grids: --grid 2048 would otherwise need 134 M bins).
+/// Any side is correct; larger bins only make each sample point look at more triangles.
+std::int32_t bin_size_for(const VoronoiGrid& grid, std::int32_t preferred);
+
 /// Checks what the backends rely on: 9 coordinates and a site per triangle, a band (>= 0, not
 /// NaN) per sample voxel, voxel ids inside the grid, and a CSR binning consistent with the grid
 /// (as bin_triangles() makes it). Throws std::invalid_argument naming the problem. Sortedness

@@ -17,7 +17,8 @@ namespace {
 // (a capped value gives D_l = cap - δ, which then simply culls less). Self bands start from the
 // 2-ring bound, which is about one edge length, so the cap rarely binds at the default grid.
 constexpr double kMaxSelfBandCells = 3.0;
-// Bins of this many voxels per side for the backends' triangle lookup.
+// Bins of this many voxels per side for the backends' triangle lookup (more on very fine
+// grids: bin_size_for()).
 constexpr std::int32_t kBinSize = 4;
 
 struct Sample {
@@ -129,7 +130,7 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
     if (k == 0 || samples[k].voxel != samples[k - 1].voxel) ++out.sample_voxels;
   }
   out.samples = samples.size();
-  bin_triangles(in.dvd, kBinSize);
+  bin_triangles(in.dvd, bin_size_for(in.dvd.grid, kBinSize));
   out.setup_ms = sw.elapsed_ms();
 
   const SelfDvdOutput dvd = backend.compute(in);

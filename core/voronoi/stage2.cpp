@@ -16,7 +16,8 @@ namespace {
 // Bands are capped at this many cells: a narrower band only weakens culling, never
 // correctness (values at the cap give D_l = cap - δ, which then simply does not cull).
 constexpr double kMaxBandCells = 3.0;
-// Bins of this many voxels per side for the backends' triangle lookup.
+// Bins of this many voxels per side for the backends' triangle lookup (more on very fine
+// grids: bin_size_for()).
 constexpr std::int32_t kBinSize = 4;
 
 struct VoxelHit {
@@ -109,7 +110,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
 
   // Triangles relative to the origin, in object order.
   fill_dvd_triangles(in, frame);
-  bin_triangles(in, kBinSize);
+  bin_triangles(in, bin_size_for(in.grid, kBinSize));
   out.setup_ms = sw.elapsed_ms();
 
   const DvdOutput dvd = backend.compute(in);

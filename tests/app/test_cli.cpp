@@ -83,6 +83,12 @@ TEST(Cli, UsageErrors) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   r = vproxq(scene + " --threads=-3");
   EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = vproxq(scene + " --grid=0");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = vproxq(scene + " --grid=4097");  // past kMaxGridResolution
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--grid"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("4096"), std::string::npos) << r.output;
   r = vproxq(scene + " --frames=7:9");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("has 3 frames"), std::string::npos) << r.output;
@@ -166,6 +172,21 @@ TEST(Cli, UnwritableOutputIsARuntimeError) {
   const auto r = vproxq(quote(kSamples / "two-cubes" / "scene.json") + " -o " + quote(blocker / "out") + " --quiet");
   EXPECT_EQ(r.exit_code, 4) << r.output;
   EXPECT_NE(r.output.find("out"), std::string::npos) << r.output;
+}
+
+// Running out of memory (here: a 400 MB address-space limit against --grid 4096, which needs
+// gigabytes) is a runtime error that says so and names the usual cause, and writes nothing.
+TEST(Cli, OutOfMemoryIsARuntimeErrorWithoutOutput) {
+  ScratchDir dir;
+  const auto out = dir / "out";
+  const auto r = test::run_command("ulimit -v 400000; " + std::string(VPROXQ_BINARY) + " " +
+                                   quote(kSamples / "skirt-tiny" / "scene.json") +
+                                   " --voronoi=cpu --grid 4096 --frames 0:1 --quiet -o " + quote(out));
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  EXPECT_NE(r.output.find("out of memory"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--grid"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out / "results.json"));
+  EXPECT_FALSE(fs::exists(out / "results.h5"));
 }
 
 TEST(Cli, FailureKeepsEarlierResultsIntact) {

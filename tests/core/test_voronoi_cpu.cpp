@@ -375,5 +375,32 @@ TEST(VoronoiBins, InfiniteRadiusVisitsEveryBin) {
   }
 }
 
+// bin_size_for(): the preferred side while the bins fit in kMaxBins, else the smallest side
+// that fits (so the one below it does not).
+TEST(VoronoiBins, BinSizeGrowsOnlyForVeryFineGrids) {
+  auto bins = [](const VoronoiGrid& g, std::int64_t side) {
+    std::int64_t n = 1;
+    for (const std::int32_t d : g.dims) n *= (d + side - 1) / side;
+    return n;
+  };
+  VoronoiGrid g;
+  for (const auto& dims : std::vector<std::array<std::int32_t, 3>>{
+           {1, 1, 1}, {256, 200, 64}, {1024, 1024, 1024}, {1025, 1024, 1024}, {2048, 1900, 1700},
+           {4096, 4096, 4096}, {4096, 3, 2}}) {
+    g.dims = dims;
+    const std::int32_t side = bin_size_for(g, 4);
+    SCOPED_TRACE(testing::Message() << dims[0] << "x" << dims[1] << "x" << dims[2] << ": side " << side);
+    EXPECT_GE(side, 4);
+    EXPECT_LE(bins(g, side), kMaxBins);
+    if (side > 4) {
+      EXPECT_GT(bins(g, side - 1), kMaxBins);
+    }
+  }
+  g.dims = {1024, 1024, 1024};
+  EXPECT_EQ(bin_size_for(g, 4), 4);
+  g.dims = {2048, 2048, 2048};
+  EXPECT_EQ(bin_size_for(g, 4), 8);
+}
+
 }  // namespace
 }  // namespace vproxq

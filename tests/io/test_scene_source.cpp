@@ -361,15 +361,17 @@ TEST_F(SceneSourceTest, EveryBadKeyIsReported) {
       {R"({"frames": {"files": ["a_0.obj"]}, "queries": ["ccd", "pd", "ccd"]})",
        {"\"queries[2]\" lists \"ccd\" a second time"}},
       {R"({"frames": {"files": ["a_0.obj"]}, "grid": 0})",
-       {"\"grid\" must be a positive integer, got 0"}},
+       {"\"grid\" must be an integer in [1, 4096], got 0"}},
       {R"({"frames": {"files": ["a_0.obj"]}, "grid": -5})",
-       {"\"grid\" must be a positive integer, got -5"}},
+       {"\"grid\" must be an integer in [1, 4096], got -5"}},
       {R"({"frames": {"files": ["a_0.obj"]}, "grid": 1.5})",
-       {"\"grid\" must be a positive integer, got 1.5"}},
+       {"\"grid\" must be an integer in [1, 4096], got 1.5"}},
       {R"({"frames": {"files": ["a_0.obj"]}, "grid": "64"})",
-       {"\"grid\" must be a positive integer, got \"64\""}},
+       {"\"grid\" must be an integer in [1, 4096], got \"64\""}},
       {R"({"frames": {"files": ["a_0.obj"]}, "grid": 99999999999})",
-       {"\"grid\" must be a positive integer"}},
+       {"\"grid\" must be an integer in [1, 4096]"}},
+      {R"({"frames": {"files": ["a_0.obj"]}, "grid": 4097})",
+       {"\"grid\" must be an integer in [1, 4096], got 4097"}},
   };
   for (const BadScene& c : cases) {
     SCOPED_TRACE(c.json);
