@@ -23,8 +23,4 @@ TriangleBoxTester::TriangleBoxTester(const Triangle& t, double half) {
   }
 }
 
-bool triangle_box_overlap(const Triangle& t, const Vec3& center, double half) {
-  return TriangleBoxTester(t, half).overlaps(center);
-}
-
 }  // namespace vproxq

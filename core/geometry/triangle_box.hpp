@@ -1,5 +1,5 @@
 #pragma once
-// Triangle–box overlap (separating axis test), used for conservative voxelization.
+// Triangle–cube overlap (separating axis test), used for conservative voxelization.
 #include "core/types.hpp"
 
 #include <array>
@@ -35,9 +35,5 @@ class TriangleBoxTester {
   std::array<Vec3, kAxes> axis_;
   std::array<double, kAxes> lo_, hi_;  // projections' range, widened by the cube's reach
 };
-
-/// True unless one of the 13 separating axes separates the triangle from the box centred at
-/// `center` with half side `half` (TriangleBoxTester for one box).
-bool triangle_box_overlap(const Triangle& t, const Vec3& center, double half);
 
 }  // namespace vproxq

@@ -40,9 +40,6 @@ struct TriangleDistanceResult {
 /// decision holds for coordinates of magnitude in [2^-200, 2^200] or zero (predicates.hpp).
 TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b);
 
-/// triangle_distance(a, b) when `a_first`, else triangle_distance(b, a) seen from a's side
-/// (points, features and the vertex–face case swapped). Callers that must get bitwise the
-/// same numbers for (a, b) and (b, a) pass a fixed order, e.g. "lower id first".
 /// r seen from the other triangle's side: points, features and the vertex–face case swapped.
 inline TriangleDistanceResult swapped(TriangleDistanceResult r) {
   std::swap(r.point_a, r.point_b);
@@ -54,6 +51,9 @@ inline TriangleDistanceResult swapped(TriangleDistanceResult r) {
   return r;
 }
 
+/// triangle_distance(a, b) when `a_first`, else triangle_distance(b, a) seen from a's side
+/// (points, features and the vertex–face case swapped). Callers that must get bitwise the
+/// same numbers for (a, b) and (b, a) pass a fixed order, e.g. "lower id first".
 inline TriangleDistanceResult triangle_distance_ordered(const Triangle& a, const Triangle& b,
                                                         bool a_first) {
   return a_first ? triangle_distance(a, b) : swapped(triangle_distance(b, a));
