@@ -92,18 +92,30 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
 
   // Conservative voxelization: samples per object in parallel, then sorted by (voxel, triangle)
   // (triangles are numbered in object order, so the result does not depend on threads).
+  // Only triangles whose 2-ring bound exceeds δ are sampled: for the others SD~ + δ >= δ is
+  // never below the 2-ring bound, so Stage II cannot lower their D_u. Their D_l would be at
+  // most the 2-ring bound + slack, about δ, and culls little: on the report scenes' frames
+  // 10-13 the Stage II culls went 17 -> 17 (skirt), 26 -> 26 (bowl), 11 -> 0 (funnel) and
+  // 2 -> 0 (cloth-ball) while the samples went down by up to 68%. An unsampled triangle keeps
+  // D_u = 2-ring bound and D_l = -inf: less culling, never a different answer.
   std::vector<std::vector<Sample>> hits(n);
+  std::vector<std::uint64_t> sampled(n, 0);
   parallel_for(n, threads, [&](size_t i) {
     const Object& o = frame.objects[i];
     if (o.num_triangles() < 2) return;
     for (Index t = 0; t < o.num_triangles(); ++t) {
+      if (!(ring2_bound[i][static_cast<size_t>(t)] > out.delta)) continue;
+      ++sampled[i];
       const auto global = static_cast<std::int32_t>(tri_base[i] + t);
       sg.voxelize(o.triangle(t), boxes.triangles[i][static_cast<size_t>(t)],
                   [&](std::int64_t id) { hits[i].push_back({id, global}); });
     }
   });
   std::vector<Sample> samples;
-  for (auto& h : hits) samples.insert(samples.end(), h.begin(), h.end());
+  for (size_t i = 0; i < n; ++i) {
+    samples.insert(samples.end(), hits[i].begin(), hits[i].end());
+    out.sampled_triangles += sampled[i];
+  }
   hits.clear();
   std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) {
     return a.voxel != b.voxel ? a.voxel < b.voxel : a.triangle < b.triangle;
@@ -130,6 +142,10 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
     if (k == 0 || samples[k].voxel != samples[k - 1].voxel) ++out.sample_voxels;
   }
   out.samples = samples.size();
+  if (samples.empty()) {  // no triangle can gain: D_u and D_l stay as they are
+    out.setup_ms = sw.elapsed_ms();
+    return out;
+  }
   bin_triangles(in.dvd, bin_size_for(in.dvd.grid, kBinSize));
   out.setup_ms = sw.elapsed_ms();
 
@@ -152,7 +168,7 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
   for (size_t i = 0; i < n; ++i)
     for (size_t t = 0; t < out.triangle_lower[i].size(); ++t) {
       const size_t g = static_cast<size_t>(tri_base[i]) + t;
-      // Every triangle marks at least one voxel; should one not, it stays uncullable.
+      // A sampled triangle marks at least one voxel; an unsampled one stays uncullable.
       if (sd_lower[g] != kInfinity) out.triangle_lower[i][t] = sd_lower[g] - out.delta;
       out.triangle_upper[i][t] = std::min(out.triangle_upper[i][t], sd_upper[g] + out.delta);
     }

@@ -69,6 +69,7 @@ struct SelfVoronoiBounds {
   /// [object][triangle] D_l(f) = SD~(f) - δ (a capped sample counts as its band).
   std::vector<std::vector<double>> triangle_lower;
   std::uint64_t samples = 0;        ///< (voxel, triangle) pairs evaluated
+  std::uint64_t sampled_triangles = 0;  ///< triangles with samples: those whose 2-ring bound exceeds δ
   std::uint64_t sample_voxels = 0;  ///< distinct voxels among them
   double setup_ms = 0, upload_ms = 0, compute_ms = 0, readback_ms = 0, scan_ms = 0;
 };
@@ -77,7 +78,8 @@ struct SelfVoronoiBounds {
 int default_self_grid_resolution(std::int64_t triangles);
 
 /// Runs the self Stage II on a frame. `ring2_bound` is ring2_upper_bounds(frame) (query/
-/// intra_distance.hpp): it sets each triangle's band. `grid_resolution` <= 0 picks
+/// intra_distance.hpp): it sets each triangle's band, and a triangle whose 2-ring bound is at
+/// most δ is not sampled (Stage II cannot lower its D_u; it keeps D_l = -inf). `grid_resolution` <= 0 picks
 /// default_self_grid_resolution().
 SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes,
                                               const std::vector<std::vector<double>>& ring2_bound,

@@ -60,6 +60,18 @@ TEST(CliIntra, JsonAndHdf5EqualBruteForceWithEveryBackend) {
     }
     EXPECT_GT(j["frames"][0]["stats"]["intra_exact_tests"].get<std::uint64_t>(), 0u);
     EXPECT_EQ(j["frames"][0]["stats"].contains("self_voronoi"), std::string(backend) != "off");
+    if (std::string(backend) != "off") {
+      // Sampled: the triangles of objects with pairs whose 2-ring bound exceeds δ.
+      const auto& sv = j["frames"][0]["stats"]["self_voronoi"];
+      const double delta = sv["delta"].get<double>();
+      const auto ring2 = ring2_upper_bounds(frame, 1);
+      std::uint64_t want = 0;
+      for (const auto& r : ring2)
+        if (r.size() >= 2)
+          for (const double b : r) want += b > delta;
+      EXPECT_EQ(sv["sampled_triangles"].get<std::uint64_t>(), want);
+      EXPECT_FALSE(j["frames"][0]["stats"]["voronoi"].contains("sampled_triangles"));
+    }
 
     // HDF5: the per-triangle table, object-major.
     const Hdf5Reader h5(out / "results.h5");

@@ -181,6 +181,50 @@ class Recorder final : public SelfVoronoiBackend {
   SelfDvdOutput output;
 };
 
+// Only triangles whose 2-ring bound exceeds δ get samples (Stage II cannot lower the others'
+// D_u); the others keep D_u = 2-ring bound and D_l = -inf. Both kinds occur, and Stage II
+// still culls candidates on these scenes.
+TEST(IntraStage2, OnlyTrianglesWhoseRing2BoundExceedsDeltaAreSampled) {
+  std::uint64_t sampled = 0, unsampled = 0, culled = 0;
+  for (const auto& [name, frame] : scenes()) {
+    const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
+    const auto ring2 = ring2_upper_bounds(frame, 2);
+    for (int grid : {8, 24, 64}) {
+      SCOPED_TRACE(name + ", grid " + std::to_string(grid));
+      Recorder rec;
+      const SelfVoronoiBounds vb = compute_self_voronoi_bounds(frame, boxes, ring2, rec, grid, 2);
+      size_t total = 0;
+      for (const auto& r : ring2) total += r.size();
+      std::vector<char> has_samples(total, 0);  // stays empty when no triangle is sampled
+      for (const std::int32_t t : rec.input.sample_triangle) has_samples[static_cast<size_t>(t)] = 1;
+      std::uint64_t here = 0;
+      size_t global = 0;
+      for (size_t i = 0; i < frame.objects.size(); ++i) {
+        const size_t n = ring2[i].size();
+        const bool has_pairs = n >= 2;
+        for (size_t t = 0; t < n; ++t) {
+          const bool want = has_pairs && ring2[i][t] > vb.delta;
+          const bool got = has_pairs && has_samples[global + t] != 0;
+          ASSERT_EQ(got, want) << "object " << i << " triangle " << t;
+          if (!want) {
+            EXPECT_EQ(vb.triangle_upper[i][t], ring2[i][t]);
+            EXPECT_EQ(vb.triangle_lower[i][t], -kInfinity);
+          }
+          here += want;
+          (want ? sampled : unsampled) += 1;
+        }
+        global += n;
+      }
+      EXPECT_EQ(vb.sampled_triangles, here);
+      IntraDistanceOptions opts{2, &vb};
+      culled += intra_object_distance(frame, boxes, ring2, opts).counters.intra_voronoi_culled;
+    }
+  }
+  EXPECT_GT(sampled, 1000u);
+  EXPECT_GT(unsampled, 1000u);
+  EXPECT_GT(culled, 0u);
+}
+
 // The CPU self backend against its per-sample brute force, bitwise: every sample's value is
 // the smallest double distance from the voxel centre to a triangle of the same object sharing
 // no vertex with the sample's triangle, rounded to float, or the band when none is below it.
