@@ -1,0 +1,165 @@
+// Every query against its brute force on seeded scenes of many kinds at once (blobs, soups,
+// folded sheets, exact copies, coplanar sheets touching along lines), scaled from 1e-4 to 1e3
+// and moved up to 1e5 times their size from the origin, with random threads and grids: the
+// inter-object distance (off and Stage II), the intra-object distance (off and self Stage II),
+// the intersecting pairs and CCD (off and voxel culling), all bitwise.
+#include "core/query/ccd.hpp"
+#include "core/query/inter_distance.hpp"
+#include "core/query/intersecting_pairs.hpp"
+#include "core/query/intra_distance.hpp"
+#include "core/voronoi/ccd_stage2.hpp"
+#include "core/voronoi/self_stage2.hpp"
+#include "core/voronoi/stage2.hpp"
+#include "support/random_scene.hpp"
+#include "support/self_meshes.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace vproxq {
+namespace {
+
+Frame scene_of_kind(test::Rng& rng, std::uint64_t seed) {
+  Frame f;
+  switch (seed % 5) {
+    case 0:
+      f = test::make_random_frame(seed, 2 + static_cast<int>(rng.uniform(0, 8)), rng.uniform(0.5, 4),
+                                  rng.uniform(0, 1) < 0.3 ? 2 : 1);
+      break;
+    case 1:
+      for (int i = 0; i < 3; ++i)
+        f.objects.push_back(test::make_soup(rng, Vec3(rng.uniform(0, 1.5), 0, 0), 0.5, rng.uniform(0.05, 0.4), 30,
+                                            "soup" + std::to_string(i)));
+      break;
+    case 2:
+      f.objects.push_back(test::make_folded_sheet(rng, 12, 6, 0.1, rng.uniform(0.001, 0.3), rng.uniform(0, 0.1)));
+      f.objects.push_back(test::make_folded_sheet(rng, 8, 5, 0.1, rng.uniform(0.001, 0.3), rng.uniform(0, 0.1)));
+      for (Vec3& p : f.objects[1].positions) p += Vec3(0.05, 0.05, rng.uniform(-0.2, 0.4));
+      break;
+    case 3: {  // an exact copy and a shifted copy: ties between objects
+      const Frame b = test::make_random_frame(seed, 3, 1.0, 1);
+      f.objects = b.objects;
+      f.objects.push_back(b.objects[0]);
+      Object shifted = b.objects[1];
+      for (Vec3& p : shifted.positions) p += Vec3(0.5, 0, 0);
+      f.objects.push_back(shifted);
+      break;
+    }
+    default:  // flat sheets in one plane, touching along lines
+      for (int i = 0; i < 3; ++i) {
+        Object o = test::make_folded_sheet(rng, 6, 4, 0.1, 10.0, 0.0);
+        for (Vec3& p : o.positions) p += Vec3(0.5 * i, 0, 0);
+        f.objects.push_back(o);
+      }
+  }
+  const double scales[] = {1e-4, 1e-2, 1, 1e3};
+  const double s = scales[static_cast<int>(rng.uniform(0, 4)) % 4];
+  Vec3 offset = Vec3::Zero();
+  if (rng.uniform(0, 1) < 0.5)
+    offset = Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)) * s * std::pow(10.0, rng.uniform(0, 5));
+  for (Object& o : f.objects)
+    for (Vec3& p : o.positions) p = p * s + offset;
+  return f;
+}
+
+/// The next frame: each object drifts by up to 20% of the scene's size, its vertices jitter.
+Frame next_frame(const Frame& from, const FrameBoxes& boxes, std::uint64_t seed) {
+  AABB scene;
+  for (const AABB& b : boxes.objects)
+    if (!b.empty()) scene.extend(b);
+  const double d = (scene.hi - scene.lo).norm();
+  test::Rng rng(seed);
+  Frame to = from;
+  to.index = from.index + 1;
+  for (Object& o : to.objects) {
+    const Vec3 drift(rng.uniform(-0.2, 0.2) * d, rng.uniform(-0.2, 0.2) * d, rng.uniform(-0.2, 0.2) * d);
+    const double jitter = rng.uniform(0, 0.05) * d;
+    for (Vec3& p : o.positions)
+      p += drift + Vec3(rng.uniform(-jitter, jitter), rng.uniform(-jitter, jitter), rng.uniform(-jitter, jitter));
+  }
+  return to;
+}
+
+TEST(VariedScenes, EveryQueryEqualsBruteForce) {
+  auto inter_backend = make_cpu_voronoi_backend(2);
+  auto self_backend = make_cpu_self_voronoi_backend(2);
+  std::uint64_t intersecting = 0, collisions = 0, intra_pairs = 0;
+  for (std::uint64_t seed = 1; seed <= 40; ++seed) {
+    test::Rng rng(seed * 7919);
+    Frame frame = scene_of_kind(rng, seed);
+    frame.index = 0;
+    const int threads = 1 + static_cast<int>(rng.uniform(0, 3));
+    const int grid = 1 + static_cast<int>(std::pow(2.0, rng.uniform(0, 8)));
+    SCOPED_TRACE("seed " + std::to_string(seed) + ", threads " + std::to_string(threads) + ", grid " +
+                 std::to_string(grid));
+    const FrameBoxes boxes = FrameBoxes::compute(frame, threads);
+    const ObjectBroadPhase stage1 = object_broad_phase(frame, boxes, threads);
+
+    const auto inter_ref = inter_object_distance_brute_force(frame);
+    const VoronoiBounds vb = compute_voronoi_bounds(frame, boxes, stage1, *inter_backend, grid, threads);
+    for (const VoronoiBounds* v : {static_cast<const VoronoiBounds*>(nullptr), &vb}) {
+      const auto got = inter_object_distance(frame, boxes, stage1, InterDistanceOptions{threads, v});
+      for (size_t i = 0; i < frame.objects.size(); ++i) {
+        SCOPED_TRACE(std::string(v ? "inter cpu" : "inter off") + ", object " + std::to_string(i));
+        EXPECT_EQ(got.per_object[i].nearest_object, inter_ref.per_object[i].nearest_object);
+        EXPECT_EQ(got.per_object[i].distance, inter_ref.per_object[i].distance);
+        EXPECT_EQ(got.per_object[i].triangles, inter_ref.per_object[i].triangles);
+        EXPECT_EQ(got.per_object[i].points[0], inter_ref.per_object[i].points[0]);
+        EXPECT_EQ(got.per_object[i].points[1], inter_ref.per_object[i].points[1]);
+      }
+    }
+
+    const auto intra_ref = intra_object_distance_brute_force(frame);
+    for (const auto& o : intra_ref.per_object) intra_pairs += o.has_pair();
+    const auto ring2 = ring2_upper_bounds(frame, threads);
+    const SelfVoronoiBounds sb = compute_self_voronoi_bounds(frame, boxes, ring2, *self_backend, grid, threads);
+    for (const SelfVoronoiBounds* v : {static_cast<const SelfVoronoiBounds*>(nullptr), &sb})
+      test::expect_same_intra(intra_object_distance(frame, boxes, ring2, IntraDistanceOptions{threads, v}),
+                              intra_ref, v ? "intra cpu" : "intra off");
+
+    const auto pairs_ref = intersecting_pairs_brute_force(frame);
+    intersecting += pairs_ref.pairs.size();
+    for (const VoronoiBounds* v : {static_cast<const VoronoiBounds*>(nullptr), &vb}) {
+      IntersectingPairsOptions opts;
+      opts.threads = threads;
+      opts.voronoi = v;
+      const auto got = intersecting_pairs(frame, boxes, opts);
+      ASSERT_EQ(got.pairs.size(), pairs_ref.pairs.size()) << (v ? "pairs cpu" : "pairs off");
+      for (size_t k = 0; k < got.pairs.size(); ++k) EXPECT_TRUE(got.pairs[k] == pairs_ref.pairs[k]) << "pair " << k;
+    }
+
+    const Frame to = next_frame(frame, boxes, seed);
+    const CcdStepResult ccd_ref = continuous_collisions_brute_force(frame, to);
+    collisions += ccd_ref.vf.size() + ccd_ref.ee.size();
+    const CcdSweep sweep = CcdSweep::compute(frame, to, threads);
+    const CcdVoxelCulling voxels(frame, to, sweep, grid, threads);
+    for (const CcdVoxelCulling* v : {static_cast<const CcdVoxelCulling*>(nullptr), &voxels}) {
+      SCOPED_TRACE(v ? "ccd voxels" : "ccd off");
+      const CcdStepResult got = continuous_collisions(frame, to, sweep, CcdOptions{threads, v});
+      ASSERT_EQ(got.vf.size(), ccd_ref.vf.size());
+      for (size_t k = 0; k < got.vf.size(); ++k) {
+        EXPECT_EQ(got.vf[k].object_v, ccd_ref.vf[k].object_v);
+        EXPECT_EQ(got.vf[k].vertex, ccd_ref.vf[k].vertex);
+        EXPECT_EQ(got.vf[k].object_f, ccd_ref.vf[k].object_f);
+        EXPECT_EQ(got.vf[k].face, ccd_ref.vf[k].face);
+        EXPECT_EQ(got.vf[k].toi, ccd_ref.vf[k].toi);
+      }
+      ASSERT_EQ(got.ee.size(), ccd_ref.ee.size());
+      for (size_t k = 0; k < got.ee.size(); ++k) {
+        EXPECT_EQ(got.ee[k].object_a, ccd_ref.ee[k].object_a);
+        EXPECT_EQ(got.ee[k].edge_a, ccd_ref.ee[k].edge_a);
+        EXPECT_EQ(got.ee[k].object_b, ccd_ref.ee[k].object_b);
+        EXPECT_EQ(got.ee[k].edge_b, ccd_ref.ee[k].edge_b);
+        EXPECT_EQ(got.ee[k].toi, ccd_ref.ee[k].toi);
+      }
+    }
+  }
+  // The scenes exercise what they compare: intersections, collisions and self pairs.
+  EXPECT_GT(intersecting, 1000u);
+  EXPECT_GT(collisions, 1000u);
+  EXPECT_GT(intra_pairs, 100u);
+}
+
+}  // namespace
+}  // namespace vproxq
