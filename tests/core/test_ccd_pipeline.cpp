@@ -7,6 +7,7 @@
 #include "core/geometry/ccd.hpp"
 #include "core/query/ccd.hpp"
 #include "core/voronoi/ccd_stage2.hpp"
+#include "support/expect_same.hpp"
 #include "support/random_scene.hpp"
 
 #include <cstdio>
@@ -14,37 +15,8 @@
 namespace vproxq {
 namespace {
 
+using test::expect_same_ccd;
 using test::moved;
-
-void expect_same(const CcdStepResult& a, const CcdStepResult& b) {
-  ASSERT_EQ(a.vf.size(), b.vf.size());
-  for (size_t k = 0; k < a.vf.size(); ++k) {
-    EXPECT_EQ(a.vf[k].object_v, b.vf[k].object_v);
-    EXPECT_EQ(a.vf[k].vertex, b.vf[k].vertex);
-    EXPECT_EQ(a.vf[k].object_f, b.vf[k].object_f);
-    EXPECT_EQ(a.vf[k].face, b.vf[k].face);
-    EXPECT_EQ(a.vf[k].toi, b.vf[k].toi);
-  }
-  ASSERT_EQ(a.ee.size(), b.ee.size());
-  for (size_t k = 0; k < a.ee.size(); ++k) {
-    EXPECT_EQ(a.ee[k].object_a, b.ee[k].object_a);
-    EXPECT_EQ(a.ee[k].edge_a, b.ee[k].edge_a);
-    EXPECT_EQ(a.ee[k].object_b, b.ee[k].object_b);
-    EXPECT_EQ(a.ee[k].edge_b, b.ee[k].edge_b);
-    EXPECT_EQ(a.ee[k].toi, b.ee[k].toi);
-  }
-  ASSERT_EQ(a.pairs.size(), b.pairs.size());
-  for (size_t k = 0; k < a.pairs.size(); ++k) {
-    EXPECT_EQ(a.pairs[k].objects, b.pairs[k].objects);
-    EXPECT_EQ(a.pairs[k].toi, b.pairs[k].toi);
-    EXPECT_EQ(a.pairs[k].primitive_pairs, b.pairs[k].primitive_pairs);
-  }
-  ASSERT_EQ(a.skipped.size(), b.skipped.size());
-  for (size_t k = 0; k < a.skipped.size(); ++k) {
-    EXPECT_EQ(a.skipped[k].object, b.skipped[k].object);
-    EXPECT_EQ(a.skipped[k].reason, b.skipped[k].reason);
-  }
-}
 
 TEST(CcdPipeline, RandomStepsEqualBruteForceWithEveryCulling) {
   std::uint64_t inter = 0, intra = 0, tests_off = 0, tests_vox = 0, brute_tests = 0, separated = 0;
@@ -59,7 +31,7 @@ TEST(CcdPipeline, RandomStepsEqualBruteForceWithEveryCulling) {
     for (const auto& p : ref.pairs) (p.objects[0] == p.objects[1] ? intra : inter) += p.primitive_pairs;
     for (int threads : {1, 3}) {
       const CcdStepResult r = continuous_collisions(from, to, CcdOptions{threads, nullptr});
-      expect_same(r, ref);
+      expect_same_ccd(r, ref);
       if (threads == 1) tests_off += r.counters.elementary_tests();
       if (threads == 1) separated += r.counters.separated_pairs;
       const CcdSweep sweep = CcdSweep::compute(from, to, threads);
@@ -67,7 +39,7 @@ TEST(CcdPipeline, RandomStepsEqualBruteForceWithEveryCulling) {
         SCOPED_TRACE("grid " + std::to_string(grid));
         const CcdVoxelCulling voxels(from, to, sweep, grid, threads);
         const CcdStepResult v = continuous_collisions(from, to, sweep, CcdOptions{threads, &voxels});
-        expect_same(v, ref);
+        expect_same_ccd(v, ref);
         if (threads == 1 && grid == 64) tests_vox += v.counters.elementary_tests();
       }
     }
@@ -95,10 +67,10 @@ TEST(CcdPipeline, TriangleSoupsEqualBruteForce) {
   const Frame to = moved(from, 9, 0.4, 0.2);
   const CcdStepResult ref = continuous_collisions_brute_force(from, to);
   EXPECT_GT(ref.vf.size() + ref.ee.size(), 0u);
-  expect_same(continuous_collisions(from, to, CcdOptions{2, nullptr}), ref);
+  expect_same_ccd(continuous_collisions(from, to, CcdOptions{2, nullptr}), ref);
   const CcdSweep sweep = CcdSweep::compute(from, to, 2);
   const CcdVoxelCulling voxels(from, to, sweep, 32, 2);
-  expect_same(continuous_collisions(from, to, sweep, CcdOptions{2, &voxels}), ref);
+  expect_same_ccd(continuous_collisions(from, to, sweep, CcdOptions{2, &voxels}), ref);
 }
 
 TEST(CcdPipeline, LargeCoordinateOffsetEqualsBruteForce) {
@@ -110,7 +82,7 @@ TEST(CcdPipeline, LargeCoordinateOffsetEqualsBruteForce) {
   EXPECT_GT(ref.vf.size() + ref.ee.size(), 0u);
   const CcdSweep sweep = CcdSweep::compute(from, to, 2);
   const CcdVoxelCulling voxels(from, to, sweep, 48, 2);
-  expect_same(continuous_collisions(from, to, sweep, CcdOptions{2, &voxels}), ref);
+  expect_same_ccd(continuous_collisions(from, to, sweep, CcdOptions{2, &voxels}), ref);
 }
 
 TEST(CcdPipeline, TopologyChangeAndMissingObjectAreSkipped) {
@@ -137,7 +109,7 @@ TEST(CcdPipeline, TopologyChangeAndMissingObjectAreSkipped) {
     EXPECT_NE(h.object_f, 1);
     EXPECT_NE(h.object_v, 3);
   }
-  expect_same(r, continuous_collisions_brute_force(from, to));
+  expect_same_ccd(r, continuous_collisions_brute_force(from, to));
   EXPECT_EQ(r.to_frame, 1);
 }
 
@@ -167,7 +139,7 @@ TEST(CcdPipeline, IncidentPairsAreExcludedButNeighboursAreTested) {
   // The only edge pair without a shared vertex is (1-2, 0-3); edge 0-3 sweeps through the
   // plane z = 0 only at points with x + y <= 0.7, never reaching edge 1-2 (x + y = 1).
   EXPECT_TRUE(r.ee.empty());
-  expect_same(r, continuous_collisions_brute_force(from, to));
+  expect_same_ccd(r, continuous_collisions_brute_force(from, to));
   ASSERT_EQ(r.pairs.size(), 1u);
   EXPECT_EQ(r.pairs[0].objects, (std::array<Index, 2>{0, 0}));
 }

@@ -2,6 +2,7 @@
 #include "core/broad_phase/object_broad_phase.hpp"
 #include "core/broad_phase/triangle_bvh.hpp"
 #include "core/query/inter_distance.hpp"
+#include "support/expect_same.hpp"
 #include "support/random_scene.hpp"
 
 #include <gtest/gtest.h>
@@ -17,24 +18,6 @@ using test::make_random_frame;
 using test::make_soup;
 using test::Rng;
 
-/// Pipeline and brute force must agree exactly: both evaluate the same triangle pairs in the
-/// same canonical order, so the winning pair and every number are bitwise identical.
-void expect_same(const InterDistanceOutput& got, const InterDistanceOutput& ref, const std::string& what) {
-  ASSERT_EQ(got.per_object.size(), ref.per_object.size()) << what;
-  for (size_t i = 0; i < ref.per_object.size(); ++i) {
-    const auto& g = got.per_object[i];
-    const auto& r = ref.per_object[i];
-    SCOPED_TRACE(what + ", object " + std::to_string(i));
-    EXPECT_EQ(g.object, r.object);
-    EXPECT_EQ(g.nearest_object, r.nearest_object);
-    EXPECT_EQ(g.distance, r.distance);
-    EXPECT_EQ(g.triangles, r.triangles);
-    EXPECT_EQ(g.points[0], r.points[0]);
-    EXPECT_EQ(g.points[1], r.points[1]);
-    EXPECT_EQ(g.kind, r.kind);
-  }
-}
-
 TEST(InterDistance, RandomBlobScenesEqualBruteForce) {
   std::uint64_t separated = 0;
   for (std::uint64_t seed = 1; seed <= 12; ++seed) {
@@ -44,7 +27,7 @@ TEST(InterDistance, RandomBlobScenesEqualBruteForce) {
     const auto ref = inter_object_distance_brute_force(frame);
     for (int threads : {1, 3}) {
       const auto got = inter_object_distance(frame, {threads});
-      expect_same(got, ref, "seed " + std::to_string(seed) + " threads " + std::to_string(threads));
+      test::expect_same_inter(got, ref, "seed " + std::to_string(seed) + " threads " + std::to_string(threads));
       EXPECT_LE(got.counters.exact_tests, ref.counters.exact_tests);
       separated += got.counters.separation_culled;
     }
@@ -61,7 +44,7 @@ TEST(InterDistance, TriangleSoupsWithManyIntersectionsEqualBruteForce) {
       frame.objects.push_back(make_soup(rng, Vec3(rng.uniform(0, 2), rng.uniform(0, 2), 0), 0.6, 0.4,
                                         30, "soup" + std::to_string(i)));
     const auto ref = inter_object_distance_brute_force(frame);
-    expect_same(inter_object_distance(frame, {2}), ref, "soup seed " + std::to_string(seed));
+    test::expect_same_inter(inter_object_distance(frame, {2}), ref, "soup seed " + std::to_string(seed));
   }
 }
 
@@ -69,7 +52,7 @@ TEST(InterDistance, LargeCoordinateOffsetEqualsBruteForce) {
   Frame frame = make_random_frame(7, 6, 2.0, 1);
   for (auto& o : frame.objects)
     for (auto& p : o.positions) p += Vec3(1e6, -1e6, 1e6);
-  expect_same(inter_object_distance(frame, {2}), inter_object_distance_brute_force(frame), "offset 1e6");
+  test::expect_same_inter(inter_object_distance(frame, {2}), inter_object_distance_brute_force(frame), "offset 1e6");
 }
 
 TEST(InterDistance, TiesGoToTheSmallestIds) {
@@ -84,7 +67,7 @@ TEST(InterDistance, TiesGoToTheSmallestIds) {
   Frame frame;
   frame.objects = {mid, left, right, copy};
   const auto got = inter_object_distance(frame, {2});
-  expect_same(got, inter_object_distance_brute_force(frame), "ties");
+  test::expect_same_inter(got, inter_object_distance_brute_force(frame), "ties");
   EXPECT_EQ(got.per_object[0].nearest_object, 1);
   EXPECT_DOUBLE_EQ(got.per_object[0].distance, 1.0);
   EXPECT_EQ(got.per_object[2].nearest_object, 3);  // identical copies: distance 0
@@ -106,7 +89,7 @@ TEST(InterDistance, SingleObjectAndEmptyObjectsHaveNoNearest) {
   one.objects.push_back(empty);
   one.objects.push_back(make_blob(rng, Vec3(5, 0, 0), 1.0, 1, 0.1, "other"));
   got = inter_object_distance(one, {2});
-  expect_same(got, inter_object_distance_brute_force(one), "with empty object");
+  test::expect_same_inter(got, inter_object_distance_brute_force(one), "with empty object");
   EXPECT_FALSE(got.per_object[1].has_nearest());
   EXPECT_EQ(got.per_object[0].nearest_object, 2);
 }

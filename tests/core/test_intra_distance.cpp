@@ -181,11 +181,10 @@ class Recorder final : public SelfVoronoiBackend {
   SelfDvdOutput output;
 };
 
-// Only triangles whose 2-ring bound exceeds δ get samples (Stage II cannot lower the others'
-// D_u); the others keep D_u = 2-ring bound and D_l = -inf. Both kinds occur, and Stage II
-// still culls candidates on these scenes.
-TEST(IntraStage2, OnlyTrianglesWhoseRing2BoundExceedsDeltaAreSampled) {
-  std::uint64_t sampled = 0, unsampled = 0, culled = 0;
+/// Runs the self Stage II through a Recorder on every scene at grids 8, 24 and 64, and calls
+/// check(frame, boxes, ring2, bounds, recorder) on each run.
+template <typename Check>
+void for_each_recorded_run(const Check& check) {
   for (const auto& [name, frame] : scenes()) {
     const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
     const auto ring2 = ring2_upper_bounds(frame, 2);
@@ -193,33 +192,44 @@ TEST(IntraStage2, OnlyTrianglesWhoseRing2BoundExceedsDeltaAreSampled) {
       SCOPED_TRACE(name + ", grid " + std::to_string(grid));
       Recorder rec;
       const SelfVoronoiBounds vb = compute_self_voronoi_bounds(frame, boxes, ring2, rec, grid, 2);
-      size_t total = 0;
-      for (const auto& r : ring2) total += r.size();
-      std::vector<char> has_samples(total, 0);  // stays empty when no triangle is sampled
-      for (const std::int32_t t : rec.input.sample_triangle) has_samples[static_cast<size_t>(t)] = 1;
-      std::uint64_t here = 0;
-      size_t global = 0;
-      for (size_t i = 0; i < frame.objects.size(); ++i) {
-        const size_t n = ring2[i].size();
-        const bool has_pairs = n >= 2;
-        for (size_t t = 0; t < n; ++t) {
-          const bool want = has_pairs && ring2[i][t] > vb.delta;
-          const bool got = has_pairs && has_samples[global + t] != 0;
-          ASSERT_EQ(got, want) << "object " << i << " triangle " << t;
-          if (!want) {
-            EXPECT_EQ(vb.triangle_upper[i][t], ring2[i][t]);
-            EXPECT_EQ(vb.triangle_lower[i][t], -kInfinity);
-          }
-          here += want;
-          (want ? sampled : unsampled) += 1;
-        }
-        global += n;
-      }
-      EXPECT_EQ(vb.sampled_triangles, here);
-      IntraDistanceOptions opts{2, &vb};
-      culled += intra_object_distance(frame, boxes, ring2, opts).counters.intra_voronoi_culled;
+      check(frame, boxes, ring2, vb, rec);
     }
   }
+}
+
+// Only triangles whose 2-ring bound exceeds δ get samples (Stage II cannot lower the others'
+// D_u); the others keep D_u = 2-ring bound and D_l = -inf. Both kinds occur, and Stage II
+// still culls candidates on these scenes.
+TEST(IntraStage2, OnlyTrianglesWhoseRing2BoundExceedsDeltaAreSampled) {
+  std::uint64_t sampled = 0, unsampled = 0, culled = 0;
+  for_each_recorded_run([&](const Frame& frame, const FrameBoxes& boxes, const std::vector<std::vector<double>>& ring2,
+                            const SelfVoronoiBounds& vb, const Recorder& rec) {
+    size_t total = 0;
+    for (const auto& r : ring2) total += r.size();
+    std::vector<char> has_samples(total, 0);  // stays empty when no triangle is sampled
+    for (const std::int32_t t : rec.input.sample_triangle) has_samples[static_cast<size_t>(t)] = 1;
+    std::uint64_t here = 0;
+    size_t global = 0;
+    for (size_t i = 0; i < frame.objects.size(); ++i) {
+      const size_t n = ring2[i].size();
+      const bool has_pairs = n >= 2;
+      for (size_t t = 0; t < n; ++t) {
+        const bool want = has_pairs && ring2[i][t] > vb.delta;
+        const bool got = has_pairs && has_samples[global + t] != 0;
+        ASSERT_EQ(got, want) << "object " << i << " triangle " << t;
+        if (!want) {
+          EXPECT_EQ(vb.triangle_upper[i][t], ring2[i][t]);
+          EXPECT_EQ(vb.triangle_lower[i][t], -kInfinity);
+        }
+        here += want;
+        (want ? sampled : unsampled) += 1;
+      }
+      global += n;
+    }
+    EXPECT_EQ(vb.sampled_triangles, here);
+    IntraDistanceOptions opts{2, &vb};
+    culled += intra_object_distance(frame, boxes, ring2, opts).counters.intra_voronoi_culled;
+  });
   EXPECT_GT(sampled, 1000u);
   EXPECT_GT(unsampled, 1000u);
   EXPECT_GT(culled, 0u);
@@ -231,42 +241,36 @@ TEST(IntraStage2, OnlyTrianglesWhoseRing2BoundExceedsDeltaAreSampled) {
 // (Its bin walk, first-visit rule and cut-offs only skip work.)
 TEST(IntraStage2, CpuBackendEqualsPerSampleBruteForce) {
   std::uint64_t samples = 0, below_band = 0;
-  for (const auto& [name, frame] : scenes()) {
-    const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
-    const auto ring2 = ring2_upper_bounds(frame, 2);
-    for (int grid : {8, 24, 64}) {
-      SCOPED_TRACE(name + ", grid " + std::to_string(grid));
-      Recorder rec;
-      compute_self_voronoi_bounds(frame, boxes, ring2, rec, grid, 2);
-      const DvdInput& in = rec.input.dvd;
-      ASSERT_EQ(rec.output.dist.size(), in.voxels.size());
-      const std::size_t tris = in.tri_site.size();
-      std::vector<Triangle> tri(tris);
-      for (std::size_t t = 0; t < tris; ++t)
-        for (int c = 0; c < 3; ++c)
-          tri[t][static_cast<size_t>(c)] = Vec3(in.tri_xyz_d[9 * t + 3 * c], in.tri_xyz_d[9 * t + 3 * c + 1],
-                                                in.tri_xyz_d[9 * t + 3 * c + 2]);
-      for (std::size_t k = 0; k < in.voxels.size(); ++k) {
-        const auto f = static_cast<std::size_t>(rec.input.sample_triangle[k]);
-        const std::int64_t id = in.voxels[k], dx = in.grid.dims[0], dy = in.grid.dims[1];
-        const Vec3 q = in.grid.cell * Vec3(static_cast<double>(id % dx) + 0.5, static_cast<double>((id / dx) % dy) + 0.5,
-                                           static_cast<double>(id / (dx * dy)) + 0.5);
-        double best = kInfinity;
-        for (std::size_t t = 0; t < tris; ++t) {
-          if (in.tri_site[t] != in.tri_site[f]) continue;
-          bool adjacent = false;
-          for (std::size_t a = 0; a < 3; ++a)
-            for (std::size_t b = 0; b < 3; ++b)
-              adjacent = adjacent || rec.input.tri_vertices[3 * f + a] == rec.input.tri_vertices[3 * t + b];
-          if (!adjacent) best = std::min(best, std::sqrt(point_triangle_distance(q, tri[t]).squared_distance));
-        }
-        const float want = best < in.band[k] ? static_cast<float>(best) : in.band[k];
-        ASSERT_EQ(rec.output.dist[k], want) << "sample " << k;
-        ++samples;
-        below_band += best < in.band[k];
+  for_each_recorded_run([&](const Frame&, const FrameBoxes&, const std::vector<std::vector<double>>&,
+                            const SelfVoronoiBounds&, const Recorder& rec) {
+    const DvdInput& in = rec.input.dvd;
+    ASSERT_EQ(rec.output.dist.size(), in.voxels.size());
+    const std::size_t tris = in.tri_site.size();
+    std::vector<Triangle> tri(tris);
+    for (std::size_t t = 0; t < tris; ++t)
+      for (int c = 0; c < 3; ++c)
+        tri[t][static_cast<size_t>(c)] = Vec3(in.tri_xyz_d[9 * t + 3 * c], in.tri_xyz_d[9 * t + 3 * c + 1],
+                                              in.tri_xyz_d[9 * t + 3 * c + 2]);
+    for (std::size_t k = 0; k < in.voxels.size(); ++k) {
+      const auto f = static_cast<std::size_t>(rec.input.sample_triangle[k]);
+      const std::int64_t id = in.voxels[k], dx = in.grid.dims[0], dy = in.grid.dims[1];
+      const Vec3 q = in.grid.cell * Vec3(static_cast<double>(id % dx) + 0.5, static_cast<double>((id / dx) % dy) + 0.5,
+                                         static_cast<double>(id / (dx * dy)) + 0.5);
+      double best = kInfinity;
+      for (std::size_t t = 0; t < tris; ++t) {
+        if (in.tri_site[t] != in.tri_site[f]) continue;
+        bool adjacent = false;
+        for (std::size_t a = 0; a < 3; ++a)
+          for (std::size_t b = 0; b < 3; ++b)
+            adjacent = adjacent || rec.input.tri_vertices[3 * f + a] == rec.input.tri_vertices[3 * t + b];
+        if (!adjacent) best = std::min(best, std::sqrt(point_triangle_distance(q, tri[t]).squared_distance));
       }
+      const float want = best < in.band[k] ? static_cast<float>(best) : in.band[k];
+      ASSERT_EQ(rec.output.dist[k], want) << "sample " << k;
+      ++samples;
+      below_band += best < in.band[k];
     }
-  }
+  });
   // Many samples find a triangle below their band: the comparison is not only of bands.
   EXPECT_GT(samples, 10000u);
   EXPECT_GT(below_band, samples / 4);

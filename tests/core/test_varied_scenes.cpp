@@ -10,6 +10,7 @@
 #include "core/voronoi/ccd_stage2.hpp"
 #include "core/voronoi/self_stage2.hpp"
 #include "core/voronoi/stage2.hpp"
+#include "support/expect_same.hpp"
 #include "support/random_scene.hpp"
 #include "support/self_meshes.hpp"
 
@@ -100,14 +101,7 @@ TEST(VariedScenes, EveryQueryEqualsBruteForce) {
     const VoronoiBounds vb = compute_voronoi_bounds(frame, boxes, stage1, *inter_backend, grid, threads);
     for (const VoronoiBounds* v : {static_cast<const VoronoiBounds*>(nullptr), &vb}) {
       const auto got = inter_object_distance(frame, boxes, stage1, InterDistanceOptions{threads, v});
-      for (size_t i = 0; i < frame.objects.size(); ++i) {
-        SCOPED_TRACE(std::string(v ? "inter cpu" : "inter off") + ", object " + std::to_string(i));
-        EXPECT_EQ(got.per_object[i].nearest_object, inter_ref.per_object[i].nearest_object);
-        EXPECT_EQ(got.per_object[i].distance, inter_ref.per_object[i].distance);
-        EXPECT_EQ(got.per_object[i].triangles, inter_ref.per_object[i].triangles);
-        EXPECT_EQ(got.per_object[i].points[0], inter_ref.per_object[i].points[0]);
-        EXPECT_EQ(got.per_object[i].points[1], inter_ref.per_object[i].points[1]);
-      }
+      test::expect_same_inter(got, inter_ref, v ? "inter cpu" : "inter off");
     }
 
     const auto intra_ref = intra_object_distance_brute_force(frame);
@@ -136,23 +130,7 @@ TEST(VariedScenes, EveryQueryEqualsBruteForce) {
     const CcdVoxelCulling voxels(frame, to, sweep, grid, threads);
     for (const CcdVoxelCulling* v : {static_cast<const CcdVoxelCulling*>(nullptr), &voxels}) {
       SCOPED_TRACE(v ? "ccd voxels" : "ccd off");
-      const CcdStepResult got = continuous_collisions(frame, to, sweep, CcdOptions{threads, v});
-      ASSERT_EQ(got.vf.size(), ccd_ref.vf.size());
-      for (size_t k = 0; k < got.vf.size(); ++k) {
-        EXPECT_EQ(got.vf[k].object_v, ccd_ref.vf[k].object_v);
-        EXPECT_EQ(got.vf[k].vertex, ccd_ref.vf[k].vertex);
-        EXPECT_EQ(got.vf[k].object_f, ccd_ref.vf[k].object_f);
-        EXPECT_EQ(got.vf[k].face, ccd_ref.vf[k].face);
-        EXPECT_EQ(got.vf[k].toi, ccd_ref.vf[k].toi);
-      }
-      ASSERT_EQ(got.ee.size(), ccd_ref.ee.size());
-      for (size_t k = 0; k < got.ee.size(); ++k) {
-        EXPECT_EQ(got.ee[k].object_a, ccd_ref.ee[k].object_a);
-        EXPECT_EQ(got.ee[k].edge_a, ccd_ref.ee[k].edge_a);
-        EXPECT_EQ(got.ee[k].object_b, ccd_ref.ee[k].object_b);
-        EXPECT_EQ(got.ee[k].edge_b, ccd_ref.ee[k].edge_b);
-        EXPECT_EQ(got.ee[k].toi, ccd_ref.ee[k].toi);
-      }
+      test::expect_same_ccd(continuous_collisions(frame, to, sweep, CcdOptions{threads, v}), ccd_ref);
     }
   }
   // The scenes exercise what they compare: intersections, collisions and self pairs.

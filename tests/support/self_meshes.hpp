@@ -4,6 +4,7 @@
 // isolated vertices.
 #include "core/query/intra_distance.hpp"
 #include "core/scene.hpp"
+#include "support/expect_same.hpp"  // expect_same_intra, used with these meshes
 #include "support/random_scene.hpp"
 
 #include <gtest/gtest.h>
@@ -91,35 +92,6 @@ inline Object make_irregular_mesh(Rng& rng, const std::string& name = "irregular
   topo->num_vertices = static_cast<Index>(v.size());
   o.topology = std::move(topo);
   return o;
-}
-
-/// Per-triangle tables and minima must be bitwise equal: pipeline and brute force evaluate
-/// the same pairs in the same canonical order.
-inline void expect_same_intra(const IntraDistanceOutput& got, const IntraDistanceOutput& ref,
-                              const std::string& what) {
-  ASSERT_EQ(got.per_object.size(), ref.per_object.size()) << what;
-  for (size_t i = 0; i < ref.per_object.size(); ++i) {
-    const auto& g = got.per_object[i];
-    const auto& r = ref.per_object[i];
-    SCOPED_TRACE(what + ", object " + std::to_string(i));
-    EXPECT_EQ(g.object, r.object);
-    EXPECT_EQ(g.distance, r.distance);
-    EXPECT_EQ(g.triangles, r.triangles);
-    EXPECT_EQ(g.points[0], r.points[0]);
-    EXPECT_EQ(g.points[1], r.points[1]);
-    ASSERT_EQ(g.per_triangle.size(), r.per_triangle.size());
-    int mismatches = 0;
-    for (size_t t = 0; t < r.per_triangle.size(); ++t) {
-      const auto& a = g.per_triangle[t];
-      const auto& b = r.per_triangle[t];
-      const bool same = a.nearest == b.nearest && a.distance == b.distance &&
-                        a.points[0] == b.points[0] && a.points[1] == b.points[1] && a.kind == b.kind;
-      if (!same && ++mismatches <= 5)
-        ADD_FAILURE() << "triangle " << t << ": got " << a.nearest << " at " << a.distance
-                      << ", brute force " << b.nearest << " at " << b.distance;
-    }
-    EXPECT_EQ(mismatches, 0);
-  }
 }
 
 }  // namespace vproxq::test
