@@ -164,7 +164,7 @@ void run_intra(const Frame& frame, const FrameBoxes& boxes, VoronoiStage& vorono
     bounds = compute_self_voronoi_bounds(frame, boxes, ring2, *voronoi.self_backend, grid, threads);
     opts.voronoi = &bounds;
     result.self_voronoi = frame_stats(bounds, bounds.samples);
-    result.self_voronoi->sampled_triangles = static_cast<std::int64_t>(bounds.sampled_triangles);
+    result.self_voronoi->sampled_triangles = bounds.sampled_triangles;
   }
   result.time_ms.intra_voronoi = sw.elapsed_ms();
   result.time_ms.voronoi += result.time_ms.intra_voronoi;

@@ -82,8 +82,8 @@ struct VoronoiFrameStats {
   double delta_precision = 0;  ///< the backend's arithmetic error bound
   std::uint64_t sample_voxels = 0;
   std::uint64_t samples = 0;  ///< samples evaluated: (voxel, triangle) pairs for the self Stage II, = sample_voxels for the inter-object one
-  /// Self Stage II only: triangles sampled (2-ring bound above δ); -1 for the inter-object one.
-  std::int64_t sampled_triangles = -1;
+  /// Self Stage II only: triangles sampled (2-ring bound above δ); none for the inter-object one.
+  std::optional<std::uint64_t> sampled_triangles;
   double setup_ms = 0, upload_ms = 0, compute_ms = 0, readback_ms = 0, scan_ms = 0;
 };
 

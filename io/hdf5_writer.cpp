@@ -622,8 +622,7 @@ struct Hdf5ResultWriter::Impl {
       write_attribute(s, stats_where, "self_voronoi_cell", v.cell);
       write_attribute(s, stats_where, "self_voronoi_delta", v.delta);
       write_attribute(s, stats_where, "self_voronoi_samples", std::uint64_t{v.samples});
-      write_attribute(s, stats_where, "self_voronoi_sampled_triangles",
-                      std::uint64_t{static_cast<std::uint64_t>(std::max<std::int64_t>(v.sampled_triangles, 0))});
+      write_attribute(s, stats_where, "self_voronoi_sampled_triangles", v.sampled_triangles.value_or(0));
       write_attribute(s, stats_where, "self_voronoi_time_ms_compute", v.compute_ms);
     }
     close_checked(stats, "H5Gclose", stats_where);

@@ -63,7 +63,7 @@ Json voronoi_stats_json(const VoronoiFrameStats& v) {
   vj["delta_precision"] = v.delta_precision;
   vj["sample_voxels"] = v.sample_voxels;
   vj["samples"] = v.samples;
-  if (v.sampled_triangles >= 0) vj["sampled_triangles"] = v.sampled_triangles;
+  if (v.sampled_triangles) vj["sampled_triangles"] = *v.sampled_triangles;
   vj["time_ms"] = {{"setup", v.setup_ms}, {"upload", v.upload_ms}, {"compute", v.compute_ms},
                    {"readback", v.readback_ms}, {"scan", v.scan_ms}};
   return vj;

@@ -79,8 +79,8 @@ int default_self_grid_resolution(std::int64_t triangles);
 
 /// Runs the self Stage II on a frame. `ring2_bound` is ring2_upper_bounds(frame) (query/
 /// intra_distance.hpp): it sets each triangle's band, and a triangle whose 2-ring bound is at
-/// most δ is not sampled (Stage II cannot lower its D_u; it keeps D_l = -inf). `grid_resolution` <= 0 picks
-/// default_self_grid_resolution().
+/// most δ is not sampled (Stage II cannot lower its D_u; it keeps D_l = -inf).
+/// `grid_resolution` <= 0 picks default_self_grid_resolution().
 SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes,
                                               const std::vector<std::vector<double>>& ring2_bound,
                                               SelfVoronoiBackend& backend, int grid_resolution,
