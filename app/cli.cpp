@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -46,6 +47,43 @@ FrameRange parse_frame_range(const std::string& text) {
     throw UsageError("--frames " + text + ": the range is empty (B is exclusive and must exceed A)");
   return r;
 }
+
+/// An option value that must be a whole number in [lo, hi]: the message names the range and
+/// the value given (CLI11's own range checks print the type's limits, e.g. DBL_MAX in full).
+CLI::Validator whole_number(long lo, long hi, const std::string& meaning) {
+  return CLI::Validator(
+      [=](std::string& value) -> std::string {
+        const std::string expect = "expected a whole number from " + std::to_string(lo) + " to " +
+                                   std::to_string(hi) + " (" + meaning + "), got '" + value + "'";
+        const bool digits = !value.empty() && value.size() <= 18 &&
+                            value.find_first_not_of("0123456789") == std::string::npos;
+        if (!digits) return expect;
+        const long v = std::stol(value);
+        return v < lo || v > hi ? expect : std::string();
+      },
+      "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+}
+
+/// A tolerance: a finite number >= 0 (NaN would make every number differ, inf none).
+CLI::Validator tolerance() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        const std::string expect = "expected a finite number >= 0, got '" + value + "'";
+        try {
+          std::size_t used = 0;
+          const double v = std::stod(value, &used);
+          if (used != value.size() || !std::isfinite(v) || v < 0) return expect;
+        } catch (const std::exception&) {
+          return expect;
+        }
+        return {};
+      },
+      ">= 0");
+}
+
+/// The largest --threads: more threads than this only cost memory and start-up time, and
+/// tens of thousands fail to start.
+constexpr long kMaxThreads = 1024;
 
 int report(const char* kind, const std::exception& e, int code) {
   std::fprintf(stderr, "vproxq: %s: %s\n", kind, e.what());
@@ -103,9 +141,9 @@ int diff_main(int argc, char** argv) {
   app.add_option("A", a, "first results.json")->required();
   app.add_option("B", b, "second results.json")->required();
   app.add_option("--rtol", opts.rtol, "relative tolerance for numbers (default 0)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(tolerance());
   app.add_option("--atol", opts.atol, "absolute tolerance for numbers (default 0)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(tolerance());
   bool done = false;
   const int code = parse_or_exit(app, argc, argv, done);
   if (done) return code;
@@ -165,13 +203,15 @@ int cli_main(int argc, char** argv) {
                  "auto (gpu on a hardware GPU, else cpu). Default: off. Results are identical.")
       ->check(CLI::IsMember({"off", "cpu", "gpu", "auto"}));
   app.add_option("--grid", config.grid,
-                 "Voronoi grid: cells along the longest axis, at most " + std::to_string(kMaxGridResolution) +
-                     " (default: scene's \"grid\", else 4*cbrt(triangles) clamped to [32, 256])")
-      ->check(CLI::Range(1, kMaxGridResolution));
+                 "Voronoi grid: cells along the longest axis of the scene box (default: the "
+                 "scene's \"grid\", else per query: 4*cbrt(triangles) clamped to [32, 256] for "
+                 "the inter-object distance and CCD, sqrt(triangles) clamped to [32, 512] for the "
+                 "intra-object distance)")
+      ->check(whole_number(1, kMaxGridResolution, "cells along the longest axis"));
   app.add_option("--device", config.device, "EGL device index for --voronoi=gpu (default: first hardware device)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(whole_number(0, 1023, "an EGL device index"));
   app.add_option("--threads", config.threads, "worker threads (default 0: all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(whole_number(0, kMaxThreads, "0: all cores"));
   app.add_flag("-q,--quiet", config.quiet, "no progress or summary on the terminal");
   app.set_version_flag("--version", std::string("vproxq ") + VPROXQ_VERSION);
   bool done = false;

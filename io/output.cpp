@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 #include <system_error>
+#include <vector>
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -54,12 +55,40 @@ fs::path temp_name(const fs::path& dir, const char* final_name) {
   return dir / ("." + std::string(final_name) + ".tmp-" + std::to_string(::getpid()));
 }
 
-fs::path prepare_dir(const fs::path& out_dir) {
+/// The directories that prepare_dir() created for a run (deepest last), removed again when
+/// the run does not commit, so that a failed run leaves no trace of itself.
+class CreatedDirs {
+ public:
+  CreatedDirs() = default;
+  CreatedDirs(const CreatedDirs&) = delete;
+  CreatedDirs& operator=(const CreatedDirs&) = delete;
+  ~CreatedDirs() {
+    // fs::remove() removes only empty directories: one that something else has written into
+    // since stays, with what is in it.
+    std::error_code ignored;
+    for (auto it = dirs_.rbegin(); it != dirs_.rend(); ++it) fs::remove(*it, ignored);
+  }
+  void add(fs::path dir) { dirs_.push_back(std::move(dir)); }
+  void keep() { dirs_.clear(); }
+
+ private:
+  std::vector<fs::path> dirs_;
+};
+
+/// Creates `out_dir` and its missing parents, recording the ones it created in `created`.
+fs::path prepare_dir(const fs::path& out_dir, CreatedDirs& created) {
   std::error_code ec;
-  fs::create_directories(out_dir, ec);
-  if (ec) {
-    throw RuntimeError("cannot create output directory '" + out_dir.string() +
-                       "': " + ec.message());
+  std::vector<fs::path> missing;
+  for (fs::path p = out_dir; !p.empty() && !fs::exists(fs::symlink_status(p, ec)); p = p.parent_path()) {
+    missing.push_back(p);
+    if (p == p.parent_path()) break;
+  }
+  for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
+    if (fs::create_directory(*it, ec)) created.add(*it);
+    if (ec) {
+      throw RuntimeError("cannot create output directory '" + out_dir.string() +
+                         "': " + ec.message());
+    }
   }
   if (!fs::is_directory(out_dir, ec)) {
     throw RuntimeError("output path '" + out_dir.string() + "' is not a directory");
@@ -88,12 +117,13 @@ constexpr const char* kHdf5Name = "results.h5";
 // temporaries are removed (members are destroyed in reverse order).
 struct ResultWriter::Impl {
   explicit Impl(const fs::path& out_dir, const RunInfo& info)
-      : dir(prepare_dir(out_dir)),
+      : dir(prepare_dir(out_dir, created_dirs)),
         json_temp(temp_name(dir, kJsonName)),
         h5_temp(temp_name(dir, kHdf5Name)),
         json(std::in_place, json_temp.path(), info),
         h5(std::in_place, h5_temp.path(), info) {}
 
+  CreatedDirs created_dirs;  // first: destroyed after the temporaries are removed
   fs::path dir;
   TempPath json_temp;
   TempPath h5_temp;
@@ -135,6 +165,7 @@ void ResultWriter::commit() {
   m.json_temp.move_to(m.dir / kJsonName);
   m.failed = false;
   m.committed = true;
+  m.created_dirs.keep();
 }
 
 ResultWriter::~ResultWriter() = default;

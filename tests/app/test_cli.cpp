@@ -81,8 +81,15 @@ TEST(Cli, UsageErrors) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   r = vproxq(scene + " --voronoi=sometimes");
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  r = vproxq(scene + " --threads=-3");
-  EXPECT_EQ(r.exit_code, 2) << r.output;
+  // Numeric options name their range and the value given.
+  for (const std::string bad : {"--threads=-3", "--threads=abc", "--threads=100000", "--threads=1.5",
+                                "--device=-1", "--device=x", "--grid=-2", "--grid=99999999999999999999"}) {
+    SCOPED_TRACE(bad);
+    r = vproxq(scene + " " + bad + " --quiet");
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find(bad.substr(0, bad.find('='))), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("got '" + bad.substr(bad.find('=') + 1) + "'"), std::string::npos) << r.output;
+  }
   r = vproxq(scene + " --grid=0");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   r = vproxq(scene + " --grid=4097");  // past kMaxGridResolution
@@ -102,6 +109,12 @@ TEST(Cli, UsageErrors) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   r = vproxq("diff onlyone.json");
   EXPECT_EQ(r.exit_code, 2) << r.output;
+  for (const std::string bad : {"--rtol=-1", "--rtol=nan", "--atol=inf", "--atol=1e-3x"}) {
+    SCOPED_TRACE(bad);
+    r = vproxq("diff a.json b.json " + bad);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("expected a finite number >= 0"), std::string::npos) << r.output;
+  }
 }
 
 /// A scene directory with frames written from random blobs, for the input-error cases.
@@ -132,12 +145,25 @@ TEST(Cli, InputErrorsNameTheFileAndLeaveNoOutput) {
     const auto r = vproxq(quote(scene) + " -o " + quote(out) + " --quiet");
     EXPECT_EQ(r.exit_code, 3) << r.output;
     EXPECT_NE(r.output.find(c.expect), std::string::npos) << r.output;
-    EXPECT_FALSE(fs::exists(out / "results.json"));
-    EXPECT_FALSE(fs::exists(out / "results.h5"));
-    if (fs::exists(out)) {
-      EXPECT_TRUE(fs::is_empty(out)) << "temporary files left behind";
-    }
+    EXPECT_FALSE(fs::exists(out)) << "the output directory the run created is left behind";
   }
+}
+
+// A failed run removes the output directories it created (all of a nested -o path), and
+// leaves an existing directory and what was in it alone.
+TEST(Cli, FailedRunRemovesTheDirectoriesItCreated) {
+  ScratchDir dir;
+  const auto scene = dir.write("scene.json", R"({"frames": {"files": ["bad.obj"]}})");
+  dir.write("bad.obj", "o a\nv 0 0 nan\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  auto r = vproxq(quote(scene) + " -o " + quote(dir / "a" / "b" / "out") + " --quiet");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "a"));
+
+  dir.write("kept/note.txt", "mine\n");
+  r = vproxq(quote(scene) + " -o " + quote(dir / "kept" / "new") + " --quiet");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "kept" / "new"));
+  EXPECT_TRUE(fs::exists(dir / "kept" / "note.txt"));
 }
 
 TEST(Cli, SceneFileErrors) {
