@@ -482,8 +482,16 @@ TEST_F(OutputTest, AbortLeavesNoFiles) {
     writer.write_frame(make_frames()[0]);
     EXPECT_EQ(dir_entries(out()).size(), 2u);  // the two temporaries
   }
-  EXPECT_TRUE(fs::is_directory(out()));
-  EXPECT_TRUE(dir_entries(out()).empty());
+  EXPECT_FALSE(fs::exists(out())) << "the writer created it, so an abort removes it";
+
+  // An existing directory stays, emptied of the temporaries only.
+  fs::create_directories(out());
+  std::ofstream(out() / "mine.txt") << "kept\n";
+  {
+    ResultWriter writer(out(), make_info());
+    writer.write_frame(make_frames()[0]);
+  }
+  EXPECT_EQ(dir_entries(out()), std::vector<std::string>{"mine.txt"});
 }
 
 TEST_F(OutputTest, AbortKeepsEarlierResultsIntact) {
@@ -551,7 +559,7 @@ TEST_F(OutputTest, DuplicateFrameFailsAndBlocksCommit) {
     }
     EXPECT_THROW(writer.commit(), RuntimeError);
   }
-  EXPECT_TRUE(dir_entries(out()).empty());
+  EXPECT_FALSE(fs::exists(out()));
 }
 
 TEST_F(OutputTest, WriteAfterCommitThrows) {
