@@ -19,5 +19,11 @@ using Triangle = std::array<Vec3, 3>;
 
 inline constexpr double kInfinity = std::numeric_limits<double>::infinity();
 inline constexpr Index kNoIndex = -1;
+/// Vertex coordinates must be finite and 0 or of magnitude in [2^-200, 2^200) (about 6.2e-61
+/// to 1.6e60): the exact predicates are exact, and the distance arithmetic free of overflow and
+/// of harmful underflow, only in that range (core/geometry/predicates.hpp); the mesh readers
+/// reject anything else as an input error.
+inline constexpr double kMinCoordinateMagnitude = 0x1p-200;
+inline constexpr double kMaxCoordinateMagnitude = 0x1p200;
 
 }  // namespace vproxq

@@ -48,12 +48,8 @@ MeshGroup convert(const fs::path& file, const aiMesh& mesh, const MeshRef& ref) 
   for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
     const aiVector3D& a = mesh.mVertices[v];
     const Vec3 p = ref.transform * Vec3(a.x, a.y, a.z);
-    const int bad = first_non_finite_axis(p);
-    if (bad >= 0) {
-      throw_input_error(file, "mesh " + label + ": vertex " + std::to_string(v) +
-                                  " (0-based) has a non-finite coordinate (" + axis_name(bad) +
-                                  " = " + std::to_string(p[bad]) + ")");
-    }
+    if (const std::string problem = coordinate_problem(p); !problem.empty())
+      throw_input_error(file, "mesh " + label + ": vertex " + std::to_string(v) + " (0-based) " + problem);
     g.positions.push_back(p);
   }
   g.faces.reserve(mesh.mNumFaces);

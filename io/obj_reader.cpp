@@ -192,11 +192,8 @@ class ObjParser {
     if (n < 3) {
       fail("malformed vertex: expected 3 coordinates, got " + std::to_string(n));
     }
-    const int bad = first_non_finite_axis(p);
-    if (bad >= 0) {
-      fail("vertex " + std::to_string(positions_.size() + 1) + " has a non-finite coordinate (" +
-           axis_name(bad) + " = " + std::to_string(p[bad]) + ")");
-    }
+    if (const std::string problem = coordinate_problem(p); !problem.empty())
+      fail("vertex " + std::to_string(positions_.size() + 1) + " " + problem);
     positions_.push_back(p);
   }
 

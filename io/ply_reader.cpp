@@ -416,12 +416,8 @@ void read_body(const fs::path& file, const Header& h, Cursor& in, Where& where, 
             in.skip(prop.type);
           }
         }
-        const int bad = first_non_finite_axis(p);
-        if (bad >= 0) {
-          throw_input_error(file, "vertex " + std::to_string(where.record) +
-                                      " (0-based) has a non-finite coordinate (" + axis_name(bad) +
-                                      " = " + std::to_string(p[bad]) + ")");
-        }
+        if (const std::string problem = coordinate_problem(p); !problem.empty())
+          throw_input_error(file, "vertex " + std::to_string(where.record) + " (0-based) " + problem);
         out.positions.push_back(p);
       }
     } else if (e.name == "face") {

@@ -77,11 +77,21 @@ const char* axis_name(int axis) {
   return kNames[axis];
 }
 
-int first_non_finite_axis(const Vec3& p) {
+std::string coordinate_problem(const Vec3& p) {
   for (int a = 0; a < 3; ++a) {
-    if (!std::isfinite(p[a])) return a;
+    // The shortest text that reads back as the same double ("1e+61", "nan", "-inf").
+    char value[64] = {};
+    std::to_chars(value, value + sizeof value - 1, p[a]);
+    if (!std::isfinite(p[a]))
+      return "has a non-finite coordinate (" + std::string(axis_name(a)) + " = " + value + ")";
+    if (std::abs(p[a]) >= kMaxCoordinateMagnitude)
+      return "has a coordinate out of range (" + std::string(axis_name(a)) + " = " + value +
+             "; the supported range is |x| < 2^200, about 1.6e60)";
+    if (p[a] != 0 && std::abs(p[a]) < kMinCoordinateMagnitude)
+      return "has a coordinate too close to 0 (" + std::string(axis_name(a)) + " = " + value +
+             "; nonzero coordinates must be at least 2^-200, about 6.2e-61, in magnitude: write 0)";
   }
-  return -1;
+  return {};
 }
 
 std::string abbreviate(std::string_view s, std::size_t max_chars) {

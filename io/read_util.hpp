@@ -33,8 +33,11 @@ std::string lower_extension(const std::filesystem::path& file);
 /// "x", "y" or "z" for axis 0, 1, 2.
 const char* axis_name(int axis);
 
-/// Index of the first non-finite coordinate of `p` (0..2), or -1 if all are finite.
-int first_non_finite_axis(const Vec3& p);
+/// What is wrong with vertex position `p` ("has a non-finite coordinate (z = nan)", "has a
+/// coordinate out of range (x = 1e+70; ...)", "has a coordinate too close to 0 (...)"), or ""
+/// when every coordinate is finite and 0 or of magnitude in [kMinCoordinateMagnitude,
+/// kMaxCoordinateMagnitude).
+std::string coordinate_problem(const Vec3& p);
 
 /// `s` shortened to at most `max_chars` characters (with "..." when cut), for messages.
 std::string abbreviate(std::string_view s, std::size_t max_chars = 40);

@@ -131,6 +131,7 @@ TEST(Cli, InputErrorsNameTheFileAndLeaveNoOutput) {
       {"index_out_of_range", good, "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "out of range"},
       {"nan", good, "o a\nv 0 0 nan\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "frame_1.obj"},
       {"inf", good, "o a\nv 0 0 inf\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "frame_1.obj"},
+      {"out_of_range", good, "o a\nv 0 0 1e61\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "frame_1.obj: line 2: vertex 1 has a coordinate out of range"},
       {"empty_frame", good, "# nothing here\n", "frame_1.obj"},
       {"object_count", good, "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "frame_1.obj"},
   };

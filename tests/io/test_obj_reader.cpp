@@ -75,7 +75,7 @@ TEST(ObjReader, PositiveIndicesMayReferToLaterVertices) {
 
 TEST(ObjReader, CoordinatesAreParsedAsDoubles) {
   TempDir dir;
-  const char* xs[] = {"0.1", "-1.2345678901234567e-300", "123456789.123456789", "+2.5", "1E+10",
+  const char* xs[] = {"0.1", "-1.2345678901234567e-60", "123456789.123456789", "+2.5", "1E+10",
                       "3"};
   std::string text;
   for (int i = 0; i < 6; i += 3) {
@@ -252,6 +252,26 @@ TEST(ObjReaderErrors, NonFiniteCoordinateNamesTheVertex) {
   EXPECT_INPUT_ERROR(read_mesh_file(b), b.string() + ": line 3:", "vertex 3", "z = -inf");
   const auto c = dir.write("huge.obj", "v 1e999 0 0\n");
   EXPECT_INPUT_ERROR(read_mesh_file(c), c.string() + ": line 1:", "vertex 1", "non-finite");
+}
+
+// Coordinates at or past 2^200 in magnitude, or nonzero below 2^-200 (outside the range where
+// the exact predicates are exact and squared distances finite) are input errors; the rest is
+// read.
+TEST(ObjReaderErrors, CoordinateOutOfRangeNamesTheVertex) {
+  TempDir dir;
+  const auto a = dir.write("far.obj", "v 0 0 0\nv 1 0 0\nv 0 1 -1e61\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(a), a.string() + ": line 3:", "vertex 3", "out of range",
+                     "z = -1e+61;", "2^200");
+  const auto b = dir.write("edge.obj", "v 1606938044258990275541962092341162602522202993782792835301376 0 0\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(b), b.string() + ": line 1:", "x = 1.6069380442589903e+60;", "out of range");
+  const auto d = dir.write("tiny.obj", "v 0 0 0\nv 1 -1e-61 0\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(d), d.string() + ": line 2:", "vertex 2", "too close to 0",
+                     "y = -1e-61;", "write 0");
+  const auto c = dir.write("ok.obj", "v 1e60 -1e60 0\nv 1 6.3e-61 -0\nv 0 1 0\nf 1 2 3\n");
+  const auto groups = read_mesh_file(c);
+  ASSERT_EQ(groups.size(), 1u);
+  EXPECT_EQ(groups[0].positions[0], Vec3(1e60, -1e60, 0));
+  EXPECT_EQ(groups[0].positions[1], Vec3(1, 6.3e-61, 0));
 }
 
 TEST(ObjReaderErrors, MalformedFaceCorners) {

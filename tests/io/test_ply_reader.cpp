@@ -18,7 +18,7 @@ std::vector<Face> faces(std::initializer_list<Face> f) { return f; }
 
 /// A square (4 vertices) as one quad plus one triangle.
 const std::vector<Vec3> kSquare = {
-    {0.1, 0.2, 0.3}, {1.0 / 3.0, 0.0, -0.0}, {1e-300, 1e300, 2.5}, {-7.25, 4.0, 1.0 / 7.0}};
+    {0.1, 0.2, 0.3}, {1.0 / 3.0, 0.0, -0.0}, {1e-60, 1e59, 2.5}, {-7.25, 4.0, 1.0 / 7.0}};
 
 TEST(PlyReader, AsciiWithExtraPropertiesAndElements) {
   TempDir dir;
@@ -323,6 +323,18 @@ TEST(PlyReaderErrors, NonFiniteCoordinates) {
   }
   const auto b = dir.write("nan.ply", s);
   EXPECT_INPUT_ERROR(read_mesh_file(b), b.string() + ": vertex 1 (0-based)", "x = nan");
+}
+
+TEST(PlyReaderErrors, CoordinatesOutOfRange) {
+  TempDir dir;
+  std::string s =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty double x\n"
+      "property double y\nproperty double z\nend_header\n";
+  for (double v : {0.0, 0.0, 0.0, 0.0, 0x1p200, 0.0}) put<double>(s, v, false);
+  const auto a = dir.write("far.ply", s);
+  EXPECT_INPUT_ERROR(read_mesh_file(a), a.string() + ": vertex 1 (0-based) has a coordinate out of range (y = 1.6069380442589903e+60;");
+  const auto b = dir.write("far_ascii.ply", ascii_header("property double x\nproperty double y\nproperty double z\n", "end_header\n0 0 0\n1 0 0\n0 -3e70 0\n"));
+  EXPECT_INPUT_ERROR(read_mesh_file(b), b.string() + ": vertex 2 (0-based)", "y = -3e+70;");
 }
 
 }  // namespace
