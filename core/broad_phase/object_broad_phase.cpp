@@ -11,6 +11,13 @@ namespace {
 
 // See rounding_slack(): ~4.5e5 ulps of the coordinate magnitude (2^-52 ~ 2.2e-16).
 constexpr double kSlackPerMagnitude = 1e-10;
+// The absolute part of rounding_slack(): underflow. Squared distances lose at most a few
+// multiples of 2^-1074 to it, which is below 2^-530 after the square root; 2^-500 covers that
+// and is negligible at every scale a scene can have (nonzero coordinates are at least 2^-200
+// in magnitude, types.hpp). An absolute part of the size of kSlackPerMagnitude instead made
+// the slack larger than the whole scene below ~1e-10 scale (every box then overlapped every
+// other, and CCD's voxel culling ran out of memory).
+constexpr double kSlackAbsolute = 0x1p-500;
 // U_i is computed in double from a few subtractions, squares and a sqrt (< 10 roundings);
 // widening it by 1e-12 relative keeps it an upper bound of the exact value.
 constexpr double kUpperBoundWidening = 1e-12;
@@ -46,7 +53,7 @@ double vertex_walk_bound(const Object& a, const Object& b, const AABB& box_b) {
 
 }  // namespace
 
-double rounding_slack(double magnitude) { return kSlackPerMagnitude * (1.0 + magnitude); }
+double rounding_slack(double magnitude) { return kSlackPerMagnitude * magnitude + kSlackAbsolute; }
 
 FrameBoxes FrameBoxes::compute(const Frame& frame, int threads) {
   FrameBoxes fb;

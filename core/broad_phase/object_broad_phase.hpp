@@ -61,7 +61,9 @@ struct ObjectBroadPhase {
 /// Absolute slack added to bounds before culling, so that rounding in box distances and in
 /// triangle_distance() can never cull a pair whose computed distance ties the bound.
 /// triangle_distance() loses at most a few hundred ulps of the coordinate magnitude; this
-/// allows ~4.5e5 ulps, so the only cost of its size is a handful of extra exact tests.
+/// allows ~4.5e5 ulps, so the only cost of its size is a handful of extra exact tests. It is
+/// relative to `magnitude` (the largest coordinate magnitude), plus 2^-500 for underflow, so
+/// it scales with the scene.
 double rounding_slack(double magnitude);
 
 /// The paper's rule: along each axis, the object whose interval overlaps i's the most (or the

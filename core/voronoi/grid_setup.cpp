@@ -2,7 +2,7 @@
 
 namespace vproxq {
 
-std::vector<std::int64_t> fill_dvd_triangles(DvdInput& in, const Frame& frame) {
+std::vector<std::int64_t> fill_dvd_triangles(DvdInput& in, const Frame& frame, const StageGrid& sg) {
   const size_t n = frame.objects.size();
   std::vector<std::int64_t> tri_base(n + 1, 0);
   for (size_t i = 0; i < n; ++i) tri_base[i + 1] = tri_base[i] + frame.objects[i].num_triangles();
@@ -16,7 +16,7 @@ std::vector<std::int64_t> fill_dvd_triangles(DvdInput& in, const Frame& frame) {
       const Triangle tri = o.triangle(t);
       for (int c = 0; c < 3; ++c)
         for (int k = 0; k < 3; ++k) {
-          const double v = tri[static_cast<size_t>(c)][k] - in.grid.origin[k];
+          const double v = (tri[static_cast<size_t>(c)][k] - sg.grid.origin[k]) / sg.unit;
           in.tri_xyz_d[g * 9 + static_cast<size_t>(c * 3 + k)] = v;
           in.tri_xyz[g * 9 + static_cast<size_t>(c * 3 + k)] = static_cast<float>(v);
         }

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace vproxq {
@@ -27,6 +28,12 @@ struct StageGrid {
   /// centre is then within `half` * sqrt(3) of the triangle, which δ accounts for.
   double voxel_slack = 0;
   double half = 0;  ///< cell / 2 + voxel_slack
+  /// The backends' length unit, a power of two with extent / unit in [0.5, 1): a backend gets
+  /// every length (coordinates relative to the origin, cell, bands) divided by it and returns
+  /// distances in it, so its float32 arithmetic sees numbers of magnitude about 1 whatever the
+  /// scene's scale (at 1e-50 or 1e50 plain float32 would underflow to 0 or overflow to inf).
+  /// Dividing and multiplying by a power of two is exact in double.
+  double unit = 1;
 
   static constexpr double kVoxelSlackRel = 1e-9;
 
@@ -42,7 +49,29 @@ struct StageGrid {
     g.extent = (g.grid.cell * Vec3(g.grid.dims[0], g.grid.dims[1], g.grid.dims[2])).norm();
     g.voxel_slack = kVoxelSlackRel * (g.extent + g.grid.cell);
     g.half = 0.5 * g.grid.cell + g.voxel_slack;
+    g.unit = std::ldexp(1.0, std::ilogb(g.extent) + 1);
     return g;
+  }
+
+  /// The grid as the backends get it: origin 0 (their coordinates are relative to
+  /// grid.origin) and the cell in backend units.
+  VoronoiGrid backend_grid() const {
+    VoronoiGrid g = grid;
+    g.origin = Vec3::Zero();
+    g.cell = grid.cell / unit;
+    return g;
+  }
+
+  /// δ_precision in scene units for a backend whose error bound (in its units) is `bound`.
+  template <typename Backend>
+  double delta_precision(const Backend& backend) const {
+    return unit * backend.distance_error_bound(extent / unit);
+  }
+
+  /// `length` (scene units) as a float in backend units, rounded up: never below the double.
+  float backend_band(double length) const {
+    const float f = static_cast<float>(length / unit);
+    return static_cast<double>(f) >= length / unit ? f : std::nextafter(f, std::numeric_limits<float>::infinity());
   }
 
   /// Lemma 2's δ: the farthest a marked voxel centre is from its triangle, plus the backend's
@@ -74,9 +103,9 @@ struct StageGrid {
   }
 };
 
-/// Fills in.tri_xyz, in.tri_xyz_d (relative to in.grid.origin) and in.tri_site (object id) with
-/// every triangle of the frame, in object order. Returns the first triangle index of each
-/// object (size objects + 1).
-std::vector<std::int64_t> fill_dvd_triangles(DvdInput& in, const Frame& frame);
+/// Fills in.tri_xyz, in.tri_xyz_d (relative to sg.grid.origin, in backend units) and
+/// in.tri_site (object id) with every triangle of the frame, in object order. Returns the
+/// first triangle index of each object (size objects + 1).
+std::vector<std::int64_t> fill_dvd_triangles(DvdInput& in, const Frame& frame, const StageGrid& sg);
 
 }  // namespace vproxq

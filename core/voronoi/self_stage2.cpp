@@ -74,14 +74,14 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
   const int res = grid_resolution > 0 ? grid_resolution : default_self_grid_resolution(total_tris);
   const StageGrid sg = StageGrid::over(scene, res);
   out.grid = sg.grid;
-  out.delta_precision = backend.distance_error_bound(sg.extent);
+  out.delta_precision = sg.delta_precision(backend);
   out.delta = sg.delta(out.delta_precision);
   const double slack = rounding_slack(boxes.magnitude);
   const double band_cap = kMaxSelfBandCells * sg.grid.cell;
 
   SelfDvdInput in;
-  in.dvd.grid = sg.grid;
-  const std::vector<std::int64_t> tri_base = fill_dvd_triangles(in.dvd, frame);
+  in.dvd.grid = sg.backend_grid();
+  const std::vector<std::int64_t> tri_base = fill_dvd_triangles(in.dvd, frame, sg);
   in.tri_vertices.resize(in.dvd.tri_site.size() * 3);
   for (size_t i = 0; i < n; ++i) {
     const auto& faces = frame.objects[i].topology->faces;
@@ -127,10 +127,9 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
   std::vector<float> tri_band(in.dvd.tri_site.size());
   for (size_t i = 0; i < n; ++i)
     for (size_t t = 0; t < ring2_bound[i].size(); ++t) {
-      const double band = std::min(ring2_bound[i][t] + out.delta + slack, band_cap);
-      // Round the float band up so that it is never below the double band.
+      // As a float in backend units, rounded up: never below the double band.
       tri_band[static_cast<size_t>(tri_base[i]) + t] =
-          std::nextafter(static_cast<float>(band), std::numeric_limits<float>::infinity());
+          sg.backend_band(std::min(ring2_bound[i][t] + out.delta + slack, band_cap));
     }
   in.dvd.voxels.reserve(samples.size());
   in.dvd.band.reserve(samples.size());
@@ -154,14 +153,15 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
   out.compute_ms = dvd.compute_ms;
   out.readback_ms = dvd.readback_ms;
 
-  // Scan: SD~(f) over f's samples. For D_l a value at or past the band only says "at least
-  // band"; for D_u only values below the band are distances to an actual triangle.
+  // Scan: SD~(f) over f's samples, back in scene units (exact: sg.unit is a power of two). For
+  // D_l a value at or past the band only says "at least band"; for D_u only values below the
+  // band are distances to an actual triangle.
   sw.restart();
   const size_t tri_count = in.dvd.tri_site.size();
   std::vector<double> sd_lower(tri_count, kInfinity), sd_upper(tri_count, kInfinity);
   for (size_t k = 0; k < samples.size(); ++k) {
     const auto t = static_cast<size_t>(in.sample_triangle[k]);
-    const double v = dvd.dist[k], band = in.dvd.band[k];
+    const double v = sg.unit * dvd.dist[k], band = sg.unit * in.dvd.band[k];
     sd_lower[t] = std::min(sd_lower[t], std::min(v, band));
     if (v < band) sd_upper[t] = std::min(sd_upper[t], v);
   }

@@ -56,7 +56,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   const StageGrid sg = StageGrid::over(scene, res);
   VoronoiGrid& grid = out.grid;
   grid = sg.grid;
-  out.delta_precision = backend.distance_error_bound(sg.extent);
+  out.delta_precision = sg.delta_precision(backend);
   out.delta = sg.delta(out.delta_precision);
   const double slack = rounding_slack(boxes.magnitude);
 
@@ -71,12 +71,13 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
 
   // Bands: object i needs exact values up to U_i + δ (+ slack) so that its capped triangles
   // are culled (D_l = band - δ > D_u); capped at kMaxBandCells cells.
-  std::vector<double> obj_band(n, 0.0);
+  // Each band is passed to the backend as a float in its units, rounded up.
+  std::vector<float> obj_band(n, 0.0f);
   for (size_t i = 0; i < n; ++i)
-    obj_band[i] = std::min(stage1.upper_bound[i] + out.delta + slack, kMaxBandCells * grid.cell);
+    obj_band[i] = sg.backend_band(std::min(stage1.upper_bound[i] + out.delta + slack, kMaxBandCells * grid.cell));
 
   DvdInput in;
-  in.grid = grid;
+  in.grid = sg.backend_grid();
   struct VoxelBand {
     std::int64_t voxel;
     float band;
@@ -88,7 +89,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   vb.reserve(total_hits);
   for (size_t i = 0; i < n; ++i)
     for (const auto& h : hits[i])
-      vb.push_back({h.voxel, static_cast<float>(obj_band[i]), static_cast<std::int32_t>(i)});
+      vb.push_back({h.voxel, obj_band[i], static_cast<std::int32_t>(i)});
   std::sort(vb.begin(), vb.end(), [](const auto& a, const auto& b) { return a.voxel < b.voxel; });
   for (size_t k = 0; k < vb.size();) {
     size_t e = k;
@@ -99,8 +100,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
       one_site = one_site && vb[e].object == vb[k].object;
     }
     in.voxels.push_back(vb[k].voxel);
-    // Round the float band up so that it is never below the double band.
-    in.band.push_back(std::nextafter(band, std::numeric_limits<float>::infinity()));
+    in.band.push_back(band);
     // A voxel touched by one object only: the scan below reads the nearest site other than
     // that object, which the backend finds faster without the object's own triangles.
     in.exclude_site.push_back(one_site ? vb[k].object : kNoIndex);
@@ -108,8 +108,8 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   }
   out.sample_voxels = in.voxels.size();
 
-  // Triangles relative to the origin, in object order.
-  fill_dvd_triangles(in, frame);
+  // Triangles relative to the origin, in backend units, in object order.
+  fill_dvd_triangles(in, frame, sg);
   bin_triangles(in, bin_size_for(in.grid, kBinSize));
   out.setup_ms = sw.elapsed_ms();
 
@@ -118,7 +118,8 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   out.compute_ms = dvd.compute_ms;
   out.readback_ms = dvd.readback_ms;
 
-  // Scan: SD~ per triangle and object from the values at their sample voxels.
+  // Scan: SD~ per triangle and object from the values at their sample voxels (back in scene
+  // units: multiplying by the power of two sg.unit is exact).
   sw.restart();
   parallel_for(n, threads, [&](size_t i) {
     double sd_obj_usable = kInfinity;  // min over values below their band
@@ -129,8 +130,8 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
           std::lower_bound(in.voxels.begin(), in.voxels.end(), h.voxel) - in.voxels.begin());
       const bool first_is_self = dvd.site1[k] == static_cast<std::int32_t>(i);
       const std::int32_t site = first_is_self ? dvd.site2[k] : dvd.site1[k];
-      const double v = first_is_self ? dvd.dist2[k] : dvd.dist1[k];
-      const double band = in.band[k];
+      const double v = sg.unit * (first_is_self ? dvd.dist2[k] : dvd.dist1[k]);
+      const double band = sg.unit * in.band[k];
       // For D_l: a value at or past the band only says "at least band".
       const double for_lower = site == kNoIndex ? band : std::min(v, band);
       double& st = sd_tri[static_cast<size_t>(h.triangle)];

@@ -139,5 +139,90 @@ TEST(VariedScenes, EveryQueryEqualsBruteForce) {
   EXPECT_GT(intra_pairs, 100u);
 }
 
+/// `v` times 2^k (exact in double while the result stays in the normal range).
+double scaled(double v, int k) { return std::ldexp(v, k); }
+
+// Scaling a scene by a power of two scales every distance exactly, so a pipeline without
+// absolute constants gives bitwise scaled results and the same counters at every scale. At
+// 2^-150 and 2^150 (past float32's range both ways) this fails when a backend hands back
+// scene-unit lengths as float32 (they underflow to 0 or overflow to inf) or when the rounding
+// slack has an absolute floor (at 2^-150 it exceeded the whole scene), both of which Stage II
+// once did. One thread: the intra-object search shares results between threads, so its counts
+// vary with timing.
+TEST(VariedScenes, PowerOfTwoScalesScaleEveryResultAndKeepEveryCount) {
+  auto inter_backend = make_cpu_voronoi_backend(1);
+  auto self_backend = make_cpu_self_voronoi_backend(1);
+  std::uint64_t bounded = 0;  // triangles with a finite D_l, at scale 1
+  for (std::uint64_t seed = 1; seed <= 15; ++seed) {
+    test::Rng rng(seed * 104729);
+    const Frame base = scene_of_kind(rng, seed);
+    const int grid = 8 + static_cast<int>(rng.uniform(0, 60));
+    struct Run {
+      InterDistanceOutput inter;
+      IntraDistanceOutput intra;
+      CcdStepResult ccd;
+      VoronoiBounds vb;
+      SelfVoronoiBounds sb;
+    };
+    auto run_at = [&](int k) {
+      Frame frame = base;
+      frame.index = 0;
+      for (Object& o : frame.objects)
+        for (Vec3& p : o.positions) p = Vec3(scaled(p.x(), k), scaled(p.y(), k), scaled(p.z(), k));
+      const FrameBoxes boxes = FrameBoxes::compute(frame, 1);
+      const ObjectBroadPhase stage1 = object_broad_phase(frame, boxes, 1);
+      Run r;
+      r.vb = compute_voronoi_bounds(frame, boxes, stage1, *inter_backend, grid, 1);
+      r.inter = inter_object_distance(frame, boxes, stage1, InterDistanceOptions{1, &r.vb});
+      const auto ring2 = ring2_upper_bounds(frame, 1);
+      r.sb = compute_self_voronoi_bounds(frame, boxes, ring2, *self_backend, grid, 1);
+      r.intra = intra_object_distance(frame, boxes, ring2, IntraDistanceOptions{1, &r.sb});
+      Frame to = next_frame(base, FrameBoxes::compute(base, 2), seed);
+      for (Object& o : to.objects)
+        for (Vec3& p : o.positions) p = Vec3(scaled(p.x(), k), scaled(p.y(), k), scaled(p.z(), k));
+      const CcdSweep sweep = CcdSweep::compute(frame, to, 1);
+      const CcdVoxelCulling voxels(frame, to, sweep, grid, 1);
+      r.ccd = continuous_collisions(frame, to, sweep, CcdOptions{1, &voxels});
+      return r;
+    };
+    const Run one = run_at(0);
+    for (const auto* lower : {&one.vb.triangle_lower, &one.sb.triangle_lower})
+      for (const auto& per_object : *lower)
+        for (const double d : per_object) bounded += d > -kInfinity;
+    for (const int k : {-150, 150}) {
+      SCOPED_TRACE("seed " + std::to_string(seed) + ", grid " + std::to_string(grid) + ", scale 2^" + std::to_string(k));
+      const Run r = run_at(k);
+      EXPECT_EQ(r.vb.delta, scaled(one.vb.delta, k));
+      EXPECT_EQ(r.sb.delta, scaled(one.sb.delta, k));
+      for (size_t i = 0; i < one.vb.triangle_lower.size(); ++i)
+        for (size_t t = 0; t < one.vb.triangle_lower[i].size(); ++t)
+          ASSERT_EQ(r.vb.triangle_lower[i][t], scaled(one.vb.triangle_lower[i][t], k)) << "object " << i << " triangle " << t;
+      for (size_t i = 0; i < one.sb.triangle_lower.size(); ++i)
+        for (size_t t = 0; t < one.sb.triangle_lower[i].size(); ++t) {
+          ASSERT_EQ(r.sb.triangle_lower[i][t], scaled(one.sb.triangle_lower[i][t], k)) << "object " << i << " triangle " << t;
+          ASSERT_EQ(r.sb.triangle_upper[i][t], scaled(one.sb.triangle_upper[i][t], k)) << "object " << i << " triangle " << t;
+        }
+      for (size_t i = 0; i < one.inter.per_object.size(); ++i) {
+        EXPECT_EQ(r.inter.per_object[i].nearest_object, one.inter.per_object[i].nearest_object);
+        EXPECT_EQ(r.inter.per_object[i].distance, scaled(one.inter.per_object[i].distance, k));
+      }
+      for (size_t i = 0; i < one.intra.per_object.size(); ++i) {
+        EXPECT_EQ(r.intra.per_object[i].triangles, one.intra.per_object[i].triangles);
+        EXPECT_EQ(r.intra.per_object[i].distance, scaled(one.intra.per_object[i].distance, k));
+      }
+      EXPECT_EQ(r.inter.counters.exact_tests, one.inter.counters.exact_tests);
+      EXPECT_EQ(r.inter.counters.feature_pns, one.inter.counters.feature_pns);
+      EXPECT_EQ(r.intra.counters.intra_exact_tests, one.intra.counters.intra_exact_tests);
+      EXPECT_EQ(r.intra.counters.intra_voronoi_culled, one.intra.counters.intra_voronoi_culled);
+      EXPECT_EQ(r.ccd.vf.size(), one.ccd.vf.size());
+      EXPECT_EQ(r.ccd.ee.size(), one.ccd.ee.size());
+      EXPECT_EQ(r.ccd.counters.culled_triangles, one.ccd.counters.culled_triangles);
+      EXPECT_EQ(r.ccd.counters.triangle_pairs, one.ccd.counters.triangle_pairs);
+      EXPECT_EQ(r.ccd.counters.elementary_tests(), one.ccd.counters.elementary_tests());
+    }
+  }
+  EXPECT_GT(bounded, 1000u);
+}
+
 }  // namespace
 }  // namespace vproxq
