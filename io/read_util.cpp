@@ -95,8 +95,23 @@ std::string coordinate_problem(const Vec3& p) {
 }
 
 std::string abbreviate(std::string_view s, std::size_t max_chars) {
-  if (s.size() <= max_chars) return std::string(s);
-  return std::string(s.substr(0, max_chars)) + "...";
+  const bool cut = s.size() > max_chars;
+  if (cut) s = s.substr(0, max_chars);
+  // Control bytes as \xNN, so that a binary file read as text cannot put control sequences
+  // on the user's terminal (bytes from 0x80 up pass: they may be UTF-8 text).
+  std::string out;
+  for (const char c : s) {
+    const auto b = static_cast<unsigned char>(c);
+    if (b >= 0x20 && b != 0x7f) {
+      out += c;
+    } else {
+      static const char* const kHex = "0123456789abcdef";
+      out += "\\x";
+      out += kHex[b >> 4];
+      out += kHex[b & 15];
+    }
+  }
+  return cut ? out + "..." : out;
 }
 
 }  // namespace vproxq::io_detail

@@ -39,7 +39,8 @@ const char* axis_name(int axis);
 /// kMaxCoordinateMagnitude).
 std::string coordinate_problem(const Vec3& p);
 
-/// `s` shortened to at most `max_chars` characters (with "..." when cut), for messages.
+/// `s` shortened to at most `max_chars` characters (with "..." when cut), control bytes
+/// written as \xNN, for messages.
 std::string abbreviate(std::string_view s, std::size_t max_chars = 40);
 
 }  // namespace vproxq::io_detail

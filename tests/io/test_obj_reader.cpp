@@ -288,6 +288,14 @@ TEST(ObjReaderErrors, MalformedFaceCorners) {
 
 TEST(ObjReaderErrors, UnknownStatementAndLineContinuation) {
   TempDir dir;
+  // Control bytes (a binary file, an escape sequence) are shown escaped, never raw.
+  const auto bin = dir.write("bin.obj", std::string("\x01\x1b[31mred\x7f 1 2\n"));
+  EXPECT_INPUT_ERROR(read_mesh_file(bin), bin.string() + ": line 1:", "unknown statement '\\x01\\x1b[31mred\\x7f'");
+  try {
+    read_mesh_file(bin);
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).find('\x1b'), std::string::npos) << e.what();
+  }
   const auto a = dir.write("a.obj", "v 0 0 0\nvertex 1 2 3\n");
   EXPECT_INPUT_ERROR(read_mesh_file(a), a.string() + ": line 2:", "unknown statement 'vertex'");
   const auto b = dir.write("b.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 \\\n 3\n");
