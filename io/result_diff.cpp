@@ -10,6 +10,7 @@
 #include <cstring>
 #include <fstream>
 #include <optional>
+#include <system_error>
 
 namespace vproxq {
 
@@ -26,6 +27,10 @@ constexpr const char* kIgnoredPerFrame = "stats";
 constexpr std::size_t kMaxValueText = 80;
 
 Json load_results(const fs::path& file) {
+  std::error_code ec;
+  if (fs::is_directory(file, ec)) {
+    throw InputError("'" + file.string() + "' is a directory, not a results file (give OUT/results.json)");
+  }
   std::ifstream in(file, std::ios::binary);
   if (!in) {
     throw InputError("cannot open results file '" + file.string() + "': " + std::strerror(errno));

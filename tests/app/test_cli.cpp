@@ -298,6 +298,9 @@ TEST(Cli, RepeatedRunsAreIdenticalAndDiffDetectsChanges) {
   EXPECT_EQ(r.exit_code, 0) << r.output;
   r = vproxq("diff " + quote(a) + " " + quote(dir / "missing.json"));
   EXPECT_EQ(r.exit_code, 3) << r.output;
+  r = vproxq("diff " + quote(a) + " " + quote(dir.path()));  // the output folder, not its file
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("is a directory, not a results file"), std::string::npos) << r.output;
 }
 
 TEST(Cli, FrameRangeAndSummary) {
