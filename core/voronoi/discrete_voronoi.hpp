@@ -28,7 +28,10 @@ struct VoronoiGrid {
 };
 
 /// What a backend gets. Coordinates are relative to grid.origin (so float32 keeps precision
-/// where it matters: the magnitude is the grid extent, not the scene's absolute position).
+/// where it matters: the magnitude is the grid extent, not the scene's absolute position);
+/// Stage II also divides every length by a power of two near the extent (StageGrid::unit), so
+/// that the magnitudes are about 1 at every scene scale. A backend needs neither: it takes the
+/// numbers as they come, and its distances are in the same units.
 struct DvdInput {
   VoronoiGrid grid;
   /// Triangles: 9 floats each (x0 y0 z0 x1 y1 z1 x2 y2 z2, relative to grid.origin), and the

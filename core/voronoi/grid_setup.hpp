@@ -62,7 +62,8 @@ struct StageGrid {
     return g;
   }
 
-  /// δ_precision in scene units for a backend whose error bound (in its units) is `bound`.
+  /// δ_precision in scene units: the backend's error bound for the extent in its units,
+  /// scaled back.
   template <typename Backend>
   double delta_precision(const Backend& backend) const {
     return unit * backend.distance_error_bound(extent / unit);
