@@ -31,6 +31,9 @@ FrameRange parse_frame_range(const std::string& text) {
   auto parse_part = [&](const std::string& s) -> long {
     if (s.empty() || s.find_first_not_of("0123456789") != std::string::npos)
       throw UsageError("--frames " + text + ": expected A:B with non-negative integers (B exclusive)");
+    // Past 10^15 no scene has that many frames, and std::stol would overflow.
+    if (s.find_first_not_of('0') != std::string::npos && s.size() - s.find_first_not_of('0') > 15)
+      throw UsageError("--frames " + text + ": frame number '" + s + "' is too large");
     return std::stol(s);
   };
   FrameRange r;

@@ -103,6 +103,11 @@ TEST(Cli, UsageErrors) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   r = vproxq(scene + " --frames=x");
   EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = vproxq(scene + " --frames=99999999999999999999:");  // past long: a usage error, not a crash
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("too large"), std::string::npos) << r.output;
+  r = vproxq(scene + " --frames=0001:2 --quiet");  // leading zeros are fine
+  EXPECT_EQ(r.exit_code, 0) << r.output;
   r = vproxq("");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   r = vproxq(scene + " --no-such-option");
