@@ -38,9 +38,10 @@ inline ProjectionGaps projection_gaps(const Triangle& a, const Triangle& b, cons
 /// 4u |gap / |w||, and |gap / |w|| <= 2 sqrt(3) M. So the result exceeds the exact distance
 /// by at most 11u M + 14u M < 2^-48 M. Axes with w . w below 2^-900 are skipped, so underflow
 /// does not enter; nothing overflows for coordinates below 2^200 in magnitude (the range where
-/// triangle_distance is exact), and an axis whose w . w or gap is not finite is skipped. Callers compare the bound with a best
-/// distance plus a slack that covers 2^-48 M and the exact test's own rounding (for Stage III,
-/// rounding_slack()), so a skipped pair could not have been at or below that best distance.
+/// triangle_distance is exact), and an axis whose w . w or gap is not finite is skipped.
+/// Callers compare the bound with a best distance plus a slack that covers 2^-48 M and the
+/// exact test's own rounding (for Stage III, rounding_slack()), so a skipped pair could not
+/// have been at or below that best distance.
 ///
 /// Symmetric: separation_lower_bound(a, b) == separation_lower_bound(b, a), bitwise.
 double separation_lower_bound(const Triangle& a, const Triangle& b);

@@ -29,15 +29,14 @@ inline double cpu_prefilter_slack(const VoronoiGrid& grid) {
          static_cast<double>(grid.dims[0] + grid.dims[1] + grid.dims[2]);
 }
 
-/// Per triangle of a DvdInput: prepared corners, bounding box, and the first bin its box
-/// overlaps (a triangle is visited in the first bin of its range that a walk reaches).
+/// Per triangle of a DvdInput: prepared corners and bounding box; with `entry_masks`, what
+/// for_each_in() needs to visit each triangle once.
 struct GatherTriangles {
   std::vector<PreparedTriangle> prepared;
   std::vector<Vec3> box_lo, box_hi;
-  std::vector<std::array<std::int32_t, 3>> first_bin;
   /// With `entry_masks`, per entry of in.bin_tris: bit a set when the entry's bin is its
-  /// triangle's first bin along axis a, so that for_each_in() decides a first visit from the
-  /// bin list alone (a sequential read instead of a lookup of first_bin per entry).
+  /// triangle's first bin along axis a (the first bin its box overlaps), so that for_each_in()
+  /// decides a first visit from the bin list alone.
   std::vector<std::uint8_t> entry_starts;
 
   GatherTriangles(const DvdInput& in, int threads, bool entry_masks = false) {
@@ -45,16 +44,16 @@ struct GatherTriangles {
     prepared.resize(n);
     box_lo.resize(n);
     box_hi.resize(n);
-    first_bin.resize(n);
     parallel_for(n, threads, [&](std::size_t t) {
       const double* c = &in.tri_xyz_d[9 * t];
       const Triangle tri{Vec3(c[0], c[1], c[2]), Vec3(c[3], c[4], c[5]), Vec3(c[6], c[7], c[8])};
       prepared[t] = prepare_triangle(tri);
       box_lo[t] = tri[0].cwiseMin(tri[1]).cwiseMin(tri[2]);
       box_hi[t] = tri[0].cwiseMax(tri[1]).cwiseMax(tri[2]);
-      first_bin[t] = bins_overlapping(in, box_lo[t], box_hi[t]).lo;
     });
     if (!entry_masks) return;
+    std::vector<std::array<std::int32_t, 3>> first_bin(n);
+    parallel_for(n, threads, [&](std::size_t t) { first_bin[t] = bins_overlapping(in, box_lo[t], box_hi[t]).lo; });
     entry_starts.resize(in.bin_tris.size());
     const std::size_t bx = static_cast<std::size_t>(in.bin_dims[0]), by = static_cast<std::size_t>(in.bin_dims[1]);
     parallel_for(in.bin_offsets.size() - 1, threads, [&](std::size_t b) {
