@@ -1,10 +1,13 @@
 #include "core/broad_phase/object_broad_phase.hpp"
 
+#include "core/broad_phase/sorted_axis.hpp"
+#include "core/broad_phase/triangle_bvh.hpp"
 #include "core/parallel.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cstddef>
 #include <cmath>
-#include <numeric>
 
 namespace vproxq {
 namespace {
@@ -90,66 +93,59 @@ ObjectBroadPhase object_broad_phase(const Frame& frame, const FrameBoxes& boxes,
     if (has_triangles(frame.objects[i])) live.push_back(static_cast<Index>(i));
   if (live.size() < 2) return out;
 
-  // Sorted intervals per axis (Cohen et al. 1995), and the widest box per axis for the sweep.
-  std::array<std::vector<Index>, 3> sorted;
-  std::array<double, 3> max_width{0, 0, 0};
-  for (int k = 0; k < 3; ++k) {
-    sorted[k] = live;
-    std::sort(sorted[k].begin(), sorted[k].end(), [&](Index a, Index b) {
-      const double la = boxes.objects[static_cast<size_t>(a)].lo[k];
-      const double lb = boxes.objects[static_cast<size_t>(b)].lo[k];
-      return la < lb || (la == lb && a < b);
-    });
-    for (Index i : live) {
-      const AABB& b = boxes.objects[static_cast<size_t>(i)];
-      max_width[k] = std::max(max_width[k], b.hi[k] - b.lo[k]);
-    }
-  }
+  // Sorted intervals per axis (Cohen et al. 1995), and a hierarchy of the boxes.
+  const std::array<SortedAxis, 3> axes{SortedAxis(live, boxes.objects, 0), SortedAxis(live, boxes.objects, 1),
+                                       SortedAxis(live, boxes.objects, 2)};
+  std::vector<AABB> live_boxes;
+  live_boxes.reserve(live.size());
+  for (Index i : live) live_boxes.push_back(boxes.objects[static_cast<size_t>(i)]);
+  TriangleBvh tree;  // over live_boxes: leaf t is object live[t]
+  tree.build(live_boxes);
 
   parallel_for(live.size(), threads, [&](size_t li) {
     const Index i = live[li];
+    const Object& oi = frame.objects[static_cast<size_t>(i)];
     const AABB& bi = boxes.objects[static_cast<size_t>(i)];
     // Potentially closest object along each axis.
     std::array<Index, 3> cand{kNoIndex, kNoIndex, kNoIndex};
-    for (int k = 0; k < 3; ++k) {
-      double best_overlap = -kInfinity;
-      for (Index j : sorted[k]) {
-        if (j == i) continue;
-        const double ov = interval_overlap(bi, boxes.objects[static_cast<size_t>(j)], k);
-        if (ov > best_overlap) {
-          best_overlap = ov;
-          cand[k] = j;
-        }
-      }
-    }
+    for (int k = 0; k < 3; ++k) cand[k] = axes[k].most_overlapping(i);
     double u = kInfinity;
     for (int k = 0; k < 3; ++k) {
       const Index j = cand[k];
       if (j == kNoIndex || (k > 0 && (j == cand[0] || (k > 1 && j == cand[1])))) continue;
       const AABB& bj = boxes.objects[static_cast<size_t>(j)];
       u = std::min(u, box_max_distance(bi, bj));
-      u = std::min(u, vertex_walk_bound(frame.objects[static_cast<size_t>(i)],
-                                        frame.objects[static_cast<size_t>(j)], bj));
+      u = std::min(u, vertex_walk_bound(oi, frame.objects[static_cast<size_t>(j)], bj));
+    }
+    // The axis rule can pick an object that overlaps i along one axis and is far away along
+    // the others (in a crowd of small objects, most of the time). The box whose farthest
+    // corner is nearest also bounds U_i; find it through the hierarchy, and walk to it too.
+    Index near = kNoIndex;
+    double near_max = u;
+    tree.query(bi, [&] { return near_max; }, [&](Index t, double) {
+      const Index j = live[static_cast<size_t>(t)];
+      if (j == i) return;
+      const double m = box_max_distance(bi, boxes.objects[static_cast<size_t>(j)]);
+      if (m < near_max || (m == near_max && near != kNoIndex && j < near)) {
+        near_max = m;
+        near = j;
+      }
+    });
+    if (near != kNoIndex && near != cand[0] && near != cand[1] && near != cand[2]) {
+      const AABB& bj = boxes.objects[static_cast<size_t>(near)];
+      u = std::min(u, near_max);
+      u = std::min(u, vertex_walk_bound(oi, frame.objects[static_cast<size_t>(near)], bj));
     }
     u *= 1 + kUpperBoundWidening;
     out.upper_bound[static_cast<size_t>(i)] = u;
 
-    // Object-level PNS: sweep along x with the box expanded by the bound.
+    // Object-level PNS: the boxes within reach of i's.
     const double reach = u + slack;
-    const auto& sx = sorted[0];
-    const double lo_min = bi.lo.x() - reach - max_width[0];
-    auto first = std::lower_bound(sx.begin(), sx.end(), lo_min, [&](Index a, double v) {
-      return boxes.objects[static_cast<size_t>(a)].lo.x() < v;
-    });
     std::vector<std::pair<double, Index>> found;
-    for (auto it = first; it != sx.end(); ++it) {
-      const Index j = *it;
-      const AABB& bj = boxes.objects[static_cast<size_t>(j)];
-      if (bj.lo.x() > bi.hi.x() + reach) break;
-      if (j == i) continue;
-      const double d2 = box_distance_squared(bi, bj);
-      if (d2 <= reach * reach) found.emplace_back(d2, j);
-    }
+    tree.query(bi, [&] { return reach; }, [&](Index t, double d2) {
+      const Index j = live[static_cast<size_t>(t)];
+      if (j != i) found.emplace_back(d2, j);
+    });
     std::sort(found.begin(), found.end());
     auto& pns = out.pns[static_cast<size_t>(i)];
     pns.reserve(found.size());

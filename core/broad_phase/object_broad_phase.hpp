@@ -67,9 +67,13 @@ struct ObjectBroadPhase {
 double rounding_slack(double magnitude);
 
 /// The paper's rule: along each axis, the object whose interval overlaps i's the most (or the
-/// nearest interval when none overlaps) is a potentially closest object; U_i is the smallest
-/// upper bound over those candidates, each bound being the smaller of the farthest-corner box
-/// distance and the distance of a vertex pair found by a short nearest-vertex walk.
+/// nearest interval when none overlaps) is a potentially closest object. To those we add the
+/// object whose box's farthest corner is nearest (found through a hierarchy of the object
+/// boxes): the axis rule alone can pick objects that are far away along the other axes. U_i is
+/// the smallest upper bound over these candidates, each bound being the smaller of the
+/// farthest-corner box distance and the distance of a vertex pair found by a short
+/// nearest-vertex walk. The PNS comes from the same hierarchy. O(n log n) in the number of
+/// objects, plus the walks (linear in the candidates' triangles).
 ObjectBroadPhase object_broad_phase(const Frame& frame, const FrameBoxes& boxes, int threads);
 
 }  // namespace vproxq
