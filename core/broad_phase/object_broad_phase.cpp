@@ -27,30 +27,46 @@ constexpr double kUpperBoundWidening = 1e-12;
 
 bool has_triangles(const Object& o) { return o.num_triangles() > 0; }
 
-/// Index of the triangle corner of `o` nearest to p (over corners of faces only: isolated
-/// vertices are not part of the surface).
-Vec3 nearest_corner(const Object& o, const Vec3& p) {
+/// The triangle corner of `o` nearest to p (over corners of faces only: isolated vertices
+/// are not part of the surface), through the object's BVH (`bvh`, over its triangles' boxes);
+/// ties go to the first face, then the first corner in it, as a scan of every face would pick.
+/// A scan made Stage I linear in a candidate's size per object: 1.8 s per frame for 5,000
+/// small objects over a 180,000-triangle ground that most of them had as a candidate.
+Vec3 nearest_corner(const Object& o, const TriangleBvh& bvh, const Vec3& p) {
   double best = kInfinity;
+  Index best_t = kNoIndex;
+  int best_c = 0;
   Vec3 best_p = Vec3::Zero();
-  for (const Face& f : o.topology->faces) {
-    for (Index v : f) {
-      const Vec3& q = o.positions[static_cast<size_t>(v)];
+  AABB point;
+  point.extend(p);
+  // Widened so that rounding in the box distances cannot prune a leaf holding a tie.
+  const auto bound = [&] { return std::sqrt(best) * (1 + 1e-9); };
+  bvh.query(point, bound, [&](Index t, double) {
+    const Face& f = o.topology->faces[static_cast<size_t>(t)];
+    for (int c = 0; c < 3; ++c) {
+      const Vec3& q = o.positions[static_cast<size_t>(f[static_cast<size_t>(c)])];
       const double d = (q - p).squaredNorm();
-      if (d < best) {
+      if (d < best || (d == best && (t < best_t || (t == best_t && c < best_c)))) {
         best = d;
+        best_t = t;
+        best_c = c;
         best_p = q;
       }
     }
-  }
+  });
   return best_p;
 }
 
-/// Distance of a pair of surface points of a and b found by walking to nearest corners:
-/// an upper bound on the distance between the objects.
-double vertex_walk_bound(const Object& a, const Object& b, const AABB& box_b) {
-  const Vec3 v = nearest_corner(a, box_b.center());
-  const Vec3 w = nearest_corner(b, v);
-  const Vec3 v2 = nearest_corner(a, w);
+/// Distance of a pair of surface points of objects a and b found by walking to nearest
+/// corners: an upper bound on the distance between the objects.
+double vertex_walk_bound(const Frame& frame, const FrameBoxes& boxes, Index a, Index b) {
+  const Object& oa = frame.objects[static_cast<size_t>(a)];
+  const Object& ob = frame.objects[static_cast<size_t>(b)];
+  const TriangleBvh& ba = boxes.bvh(static_cast<size_t>(a));
+  const TriangleBvh& bb = boxes.bvh(static_cast<size_t>(b));
+  const Vec3 v = nearest_corner(oa, ba, boxes.objects[static_cast<size_t>(b)].center());
+  const Vec3 w = nearest_corner(ob, bb, v);
+  const Vec3 v2 = nearest_corner(oa, ba, w);
   return (v2 - w).norm();
 }
 
@@ -104,7 +120,6 @@ ObjectBroadPhase object_broad_phase(const Frame& frame, const FrameBoxes& boxes,
 
   parallel_for(live.size(), threads, [&](size_t li) {
     const Index i = live[li];
-    const Object& oi = frame.objects[static_cast<size_t>(i)];
     const AABB& bi = boxes.objects[static_cast<size_t>(i)];
     // Potentially closest object along each axis.
     std::array<Index, 3> cand{kNoIndex, kNoIndex, kNoIndex};
@@ -115,7 +130,7 @@ ObjectBroadPhase object_broad_phase(const Frame& frame, const FrameBoxes& boxes,
       if (j == kNoIndex || (k > 0 && (j == cand[0] || (k > 1 && j == cand[1])))) continue;
       const AABB& bj = boxes.objects[static_cast<size_t>(j)];
       u = std::min(u, box_max_distance(bi, bj));
-      u = std::min(u, vertex_walk_bound(oi, frame.objects[static_cast<size_t>(j)], bj));
+      u = std::min(u, vertex_walk_bound(frame, boxes, i, j));
     }
     // The axis rule can pick an object that overlaps i along one axis and is far away along
     // the others (in a crowd of small objects, most of the time). The box whose farthest
@@ -132,9 +147,8 @@ ObjectBroadPhase object_broad_phase(const Frame& frame, const FrameBoxes& boxes,
       }
     });
     if (near != kNoIndex && near != cand[0] && near != cand[1] && near != cand[2]) {
-      const AABB& bj = boxes.objects[static_cast<size_t>(near)];
       u = std::min(u, near_max);
-      u = std::min(u, vertex_walk_bound(oi, frame.objects[static_cast<size_t>(near)], bj));
+      u = std::min(u, vertex_walk_bound(frame, boxes, i, near));
     }
     u *= 1 + kUpperBoundWidening;
     out.upper_bound[static_cast<size_t>(i)] = u;

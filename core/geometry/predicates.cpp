@@ -36,6 +36,14 @@ constexpr double kOrient2dErrorBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
 /// is at most (7e + 56e^2) times the permanent sum |uz|*(|vx*wy| + |vy*wx|) + ...
 constexpr double kOrient3dErrorBound = (7.0 + 56.0 * kEpsilon) * kEpsilon;
 
+// When the filter's bound is zero, every product in the permanent was computed as zero. A
+// difference of two doubles rounds to zero only when they are equal, and in the documented
+// coordinate range no product of nonzero differences underflows (they are at least 2^-252, so a
+// product of three is at least 2^-756), so each monomial of the determinant is exactly zero and
+// so is the determinant: no need for the exact fallback. This is the common degenerate case of
+// meshes (flat sheets on an axis-aligned plane, vertices on grid lines), which otherwise paid
+// for expansion arithmetic on every coplanar or collinear test.
+
 thread_local PredicateCounters g_counters;
 
 // ---- error-free transformations -------------------------------------------------------------
@@ -249,6 +257,8 @@ int orient2d(const Vec2& a, const Vec2& b, const Vec2& c) {
   if (det > bound || -det > bound) {
     return sign_of(det);
   }
+  // Both products zero: an exact zero (see above, after kOrient3dErrorBound).
+  if (bound == 0) return 0;
   return orient2d_exact(a, b, c);
 }
 
@@ -293,6 +303,8 @@ int orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   if (det > bound || -det > bound) {
     return sign_of(det);
   }
+  // Every product zero: an exact zero (see above, after kOrient3dErrorBound).
+  if (bound == 0) return 0;
   return orient3d_exact(a, b, c, d);
 }
 

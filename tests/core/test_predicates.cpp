@@ -378,6 +378,50 @@ TEST(Orient3d, FilterDecidesGenericInputs) {
   EXPECT_LE(predicate_counters().orient3d_exact - before.orient3d_exact, 5u);
 }
 
+TEST(Orient, SharedCoordinatesAreDecidedWithoutTheFallbackAndMatchTheTwin) {
+  // Points on an axis-aligned plane (3D) or line (2D), as in a flat sheet of cloth: every
+  // product of the filter's permanent is zero, which the predicates take as an exact zero.
+  // Against the exact twin at both ends of the coordinate range, with zero coordinates mixed
+  // in, and with the shared coordinate moved by an ulp (a nonzero sign the shortcut must not
+  // take).
+  std::mt19937_64 rng(11);
+  std::uniform_int_distribution<int> pick(0, 2), step(-1, 1);
+  int zeros = 0, nonzeros = 0, shortcut_zeros = 0;
+  for (int scale_exp : {-190, -40, 0, 40, 190}) {
+    const double s = std::ldexp(1.0, scale_exp);
+    for (int trial = 0; trial < 2000; ++trial) {
+      std::array<Vec3, 4> p;
+      for (Vec3& q : p) q = s * random_point(rng, 1.0);
+      const int axis = pick(rng);
+      const double shared = trial % 5 == 0 ? 0.0 : p[0][axis];
+      for (Vec3& q : p) q[axis] = shared;
+      if (trial % 7 == 0) p[1][(axis + 1) % 3] = 0;  // a zero among the others
+      const bool moved = trial % 2 == 1 && shared != 0;
+      if (moved) p[3][axis] = ulp_step(shared, step(rng) == 0 ? 1 : -1);
+      const PredicateCounters before = predicate_counters();
+      const int got = orient3d(p[0], p[1], p[2], p[3]);
+      const std::uint64_t fallbacks = predicate_counters().orient3d_exact - before.orient3d_exact;
+      ASSERT_EQ(got, exact_orient3d(p[0], p[1], p[2], p[3])) << scale_exp << " trial " << trial;
+      if (!moved) {
+        EXPECT_EQ(fallbacks, 0u) << scale_exp << " trial " << trial;
+        shortcut_zeros += got == 0;
+      }
+      (got == 0 ? zeros : nonzeros) += 1;
+      // Three of the points in 2D (the shared coordinate and another one): on a line.
+      const int other = (axis + 1) % 3;
+      std::array<Vec2, 3> t;
+      for (int k = 0; k < 3; ++k) t[static_cast<size_t>(k)] = Vec2(p[static_cast<size_t>(k)][axis], p[static_cast<size_t>(k)][other]);
+      const PredicateCounters before2 = predicate_counters();
+      const int got2 = orient2d(t[0], t[1], t[2]);
+      ASSERT_EQ(got2, exact_orient2d(t[0], t[1], t[2])) << scale_exp << " trial " << trial;
+      EXPECT_EQ(predicate_counters().orient2d_exact - before2.orient2d_exact, 0u);
+    }
+  }
+  EXPECT_GT(shortcut_zeros, 1000);
+  EXPECT_GT(nonzeros, 1000);
+  EXPECT_GT(zeros, nonzeros / 2);
+}
+
 TEST(Orient2d, ClassroomNearCollinearGrid) {
   // Kettner et al., "Classroom examples of robustness problems in geometric computations":
   // p = (0.5 + i u, 0.5 + j u), u = 2^-53, against the line through (12, 12) and (24, 24).
