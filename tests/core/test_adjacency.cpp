@@ -80,6 +80,32 @@ TEST(Adjacency, IrregularMeshes) {
   EXPECT_EQ(adj.find_edge(3, 9), kNoIndex);
 }
 
+TEST(Adjacency, HighValenceHubs) {
+  // A disc of 150 triangles around one vertex (valence 150), ringed by a strip of quads, and a
+  // closed fan (a cone with its apex and a base hub): the 1-ring of a hub triangle is the
+  // whole fan, and the 2-ring is reached only through the rim vertices.
+  Topology disc;
+  const Index n = 150;
+  disc.num_vertices = 1 + 2 * n;
+  for (Index k = 0; k < n; ++k) {
+    const Index a = 1 + k, b = 1 + (k + 1) % n, a2 = 1 + n + k, b2 = 1 + n + (k + 1) % n;
+    disc.faces.push_back({0, a, b});
+    disc.faces.push_back({a, a2, b2});
+    disc.faces.push_back({a, b2, b});
+  }
+  check_against_definitions(disc);
+  Topology cone;
+  cone.num_vertices = 2 + n;
+  for (Index k = 0; k < n; ++k) {
+    cone.faces.push_back({0, 2 + k, 2 + (k + 1) % n});
+    cone.faces.push_back({1, 2 + (k + 1) % n, 2 + k});
+  }
+  check_against_definitions(cone);
+  EXPECT_TRUE(adjacency(disc).ring2(0).size() > 0);
+  // The rest of the apex fan (n - 1) and the 3 base triangles at its two rim vertices.
+  EXPECT_EQ(adjacency(cone).ring1(0).size(), static_cast<size_t>(n + 2));
+}
+
 TEST(Adjacency, CachedPerTopologyAndResetOnCopy) {
   Topology topo;
   topo.num_vertices = 4;
