@@ -168,4 +168,26 @@ ObjectBroadPhase object_broad_phase(const Frame& frame, const FrameBoxes& boxes,
   return out;
 }
 
+std::vector<std::pair<Index, Index>> overlapping_box_pairs(const std::vector<AABB>& boxes,
+                                                           const std::vector<Index>& ids, int threads) {
+  std::vector<AABB> own;
+  own.reserve(ids.size());
+  for (Index i : ids) own.push_back(boxes[static_cast<size_t>(i)]);
+  TriangleBvh tree;  // leaf t is ids[t]
+  tree.build(own);
+  std::vector<std::vector<Index>> partners(ids.size());
+  parallel_for(ids.size(), threads, [&](size_t k) {
+    const Index a = ids[k];
+    tree.query_overlaps(own[k], [](std::int32_t) { return false; }, [&](Index t) {
+      const Index b = ids[static_cast<size_t>(t)];
+      if (a < b) partners[k].push_back(b);
+    });
+  });
+  std::vector<std::pair<Index, Index>> out;
+  for (size_t k = 0; k < ids.size(); ++k)
+    for (Index b : partners[k]) out.emplace_back(ids[k], b);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 }  // namespace vproxq

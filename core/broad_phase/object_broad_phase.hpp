@@ -8,6 +8,7 @@
 
 #include <memory>
 #include <mutex>
+#include <utility>
 #include <vector>
 
 namespace vproxq {
@@ -75,5 +76,12 @@ double rounding_slack(double magnitude);
 /// nearest-vertex walk. The PNS comes from the same hierarchy. O(n log n) in the number of
 /// objects, plus the walks (linear in the candidates' triangles).
 ObjectBroadPhase object_broad_phase(const Frame& frame, const FrameBoxes& boxes, int threads);
+
+/// Pairs (a, b), a < b, of the objects in `ids` whose boxes overlap (boxes_overlap(): closed
+/// boxes, touching included), ascending. Through a hierarchy of the boxes, in parallel: a
+/// sweep along one axis costs the number of boxes sharing a slab of that axis, which in a
+/// crowd grows with the square of the count. The boxes of `ids` must not be empty.
+std::vector<std::pair<Index, Index>> overlapping_box_pairs(const std::vector<AABB>& boxes,
+                                                           const std::vector<Index>& ids, int threads);
 
 }  // namespace vproxq

@@ -316,25 +316,13 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
   out.skipped = sweep.participants.skipped;
   Stopwatch sw;
 
-  // Stage I, object level: sweep and prune along x over the swept object boxes.
+  // Stage I, object level: the object pairs whose swept boxes overlap, and each object with
+  // itself.
   std::vector<Index> live;
   for (Index i : sweep.participants.objects)
     if (from.objects[static_cast<size_t>(i)].num_triangles() > 0) live.push_back(i);
-  std::vector<Index> by_x = live;
-  std::sort(by_x.begin(), by_x.end(), [&](Index a, Index b) {
-    const double la = sweep.objects[static_cast<size_t>(a)].lo.x(), lb = sweep.objects[static_cast<size_t>(b)].lo.x();
-    return la < lb || (la == lb && a < b);
-  });
-  std::vector<std::pair<Index, Index>> object_pairs;
+  std::vector<std::pair<Index, Index>> object_pairs = overlapping_box_pairs(sweep.objects, live, threads);
   for (Index i : live) object_pairs.emplace_back(i, i);
-  for (size_t a = 0; a < by_x.size(); ++a) {
-    const AABB& ba = sweep.objects[static_cast<size_t>(by_x[a])];
-    for (size_t b = a + 1; b < by_x.size(); ++b) {
-      const AABB& bb = sweep.objects[static_cast<size_t>(by_x[b])];
-      if (bb.lo.x() > ba.hi.x()) break;
-      if (boxes_overlap(ba, bb)) object_pairs.emplace_back(std::min(by_x[a], by_x[b]), std::max(by_x[a], by_x[b]));
-    }
-  }
   std::sort(object_pairs.begin(), object_pairs.end());
   out.counters.object_pairs = object_pairs.size();
 

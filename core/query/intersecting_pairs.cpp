@@ -1,5 +1,6 @@
 #include "core/query/intersecting_pairs.hpp"
 
+#include "core/broad_phase/object_broad_phase.hpp"
 #include "core/broad_phase/triangle_bvh.hpp"
 #include "core/geometry/triangle_distance.hpp"
 #include "core/mesh/adjacency.hpp"
@@ -12,30 +13,6 @@
 
 namespace vproxq {
 namespace {
-
-/// Object pairs (i < j) whose boxes overlap, ascending: sweep and prune along x.
-std::vector<std::pair<Index, Index>> overlapping_objects(const FrameBoxes& boxes) {
-  const auto n = static_cast<Index>(boxes.objects.size());
-  std::vector<Index> order;
-  for (Index i = 0; i < n; ++i)
-    if (!boxes.objects[static_cast<size_t>(i)].empty()) order.push_back(i);
-  std::sort(order.begin(), order.end(), [&](Index a, Index b) {
-    const double la = boxes.objects[static_cast<size_t>(a)].lo.x();
-    const double lb = boxes.objects[static_cast<size_t>(b)].lo.x();
-    return la != lb ? la < lb : a < b;
-  });
-  std::vector<std::pair<Index, Index>> out;
-  for (size_t p = 0; p < order.size(); ++p) {
-    const AABB& a = boxes.objects[static_cast<size_t>(order[p])];
-    for (size_t q = p + 1; q < order.size(); ++q) {
-      const AABB& b = boxes.objects[static_cast<size_t>(order[q])];
-      if (b.lo.x() > a.hi.x()) break;  // sorted by lo.x: no later box reaches a either
-      if (boxes_overlap(a, b)) out.emplace_back(std::min(order[p], order[q]), std::max(order[p], order[q]));
-    }
-  }
-  std::sort(out.begin(), out.end());
-  return out;
-}
 
 /// A unit of work: triangles [first, last) of object i against object j (j == i: within i).
 struct WorkItem {
@@ -63,7 +40,10 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
     const Index nt = frame.objects[static_cast<size_t>(i)].num_triangles();
     for (Index f = 0; f < nt; f += kChunk) items.push_back({i, j, f, std::min(nt, f + kChunk)});
   };
-  const auto object_pairs = overlapping_objects(boxes);
+  std::vector<Index> with_box;  // objects with triangles
+  for (size_t i = 0; i < n; ++i)
+    if (!boxes.objects[i].empty()) with_box.push_back(static_cast<Index>(i));
+  const auto object_pairs = overlapping_box_pairs(boxes.objects, with_box, threads);
   std::vector<char> needs_bvh(n, 0);
   for (const auto& [i, j] : object_pairs) {
     add_chunks(i, j);

@@ -246,5 +246,31 @@ TEST(ObjectBroadPhase, CrowdOfSmallObjects) {
   }
 }
 
+TEST(OverlappingBoxPairs, EqualsAllPairs) {
+  // Integer boxes in a small range: many touch exactly (closed boxes count), some coincide;
+  // every seventh id is left out of the query.
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    Rng rng(seed);
+    const int n = rng.integer(0, 300);
+    std::vector<AABB> boxes(static_cast<size_t>(n));
+    std::vector<Index> ids;
+    for (int i = 0; i < n; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        const double lo = rng.integer(0, 30);
+        boxes[static_cast<size_t>(i)].lo[k] = lo;
+        boxes[static_cast<size_t>(i)].hi[k] = lo + rng.integer(0, 4);
+      }
+      if (i % 7 != 3) ids.push_back(i);
+    }
+    std::vector<std::pair<Index, Index>> expected;
+    for (size_t a = 0; a < ids.size(); ++a)
+      for (size_t b = a + 1; b < ids.size(); ++b)
+        if (boxes_overlap(boxes[static_cast<size_t>(ids[a])], boxes[static_cast<size_t>(ids[b])]))
+          expected.emplace_back(ids[a], ids[b]);
+    for (int threads : {1, 3})
+      EXPECT_EQ(overlapping_box_pairs(boxes, ids, threads), expected) << "seed " << seed << " threads " << threads;
+  }
+}
+
 }  // namespace
 }  // namespace vproxq
