@@ -25,8 +25,6 @@ constexpr double kSlackAbsolute = 0x1p-500;
 // widening it by 1e-12 relative keeps it an upper bound of the exact value.
 constexpr double kUpperBoundWidening = 1e-12;
 
-bool has_triangles(const Object& o) { return o.num_triangles() > 0; }
-
 /// The triangle corner of `o` nearest to p (over corners of faces only: isolated vertices
 /// are not part of the surface), through the object's BVH (`bvh`, over its triangles' boxes);
 /// ties go to the first face, then the first corner in it, as a scan of every face would pick.
@@ -104,19 +102,14 @@ ObjectBroadPhase object_broad_phase(const Frame& frame, const FrameBoxes& boxes,
   out.pns.assign(n, {});
   const double slack = rounding_slack(boxes.magnitude);
 
-  std::vector<Index> live;  // objects with triangles
-  for (size_t i = 0; i < n; ++i)
-    if (has_triangles(frame.objects[i])) live.push_back(static_cast<Index>(i));
+  // A hierarchy of the boxes of the objects with triangles (leaf t is object live[t]), and
+  // their sorted intervals per axis (Cohen et al. 1995).
+  const ObjectBoxTree& object_tree = boxes.object_tree();
+  const std::vector<Index>& live = object_tree.ids;
+  const TriangleBvh& tree = object_tree.bvh;
   if (live.size() < 2) return out;
-
-  // Sorted intervals per axis (Cohen et al. 1995), and a hierarchy of the boxes.
   const std::array<SortedAxis, 3> axes{SortedAxis(live, boxes.objects, 0), SortedAxis(live, boxes.objects, 1),
                                        SortedAxis(live, boxes.objects, 2)};
-  std::vector<AABB> live_boxes;
-  live_boxes.reserve(live.size());
-  for (Index i : live) live_boxes.push_back(boxes.objects[static_cast<size_t>(i)]);
-  TriangleBvh tree;  // over live_boxes: leaf t is object live[t]
-  tree.build(live_boxes);
 
   parallel_for(live.size(), threads, [&](size_t li) {
     const Index i = live[li];
@@ -168,17 +161,33 @@ ObjectBroadPhase object_broad_phase(const Frame& frame, const FrameBoxes& boxes,
   return out;
 }
 
-std::vector<std::pair<Index, Index>> overlapping_box_pairs(const std::vector<AABB>& boxes,
-                                                           const std::vector<Index>& ids, int threads) {
+ObjectBoxTree ObjectBoxTree::build(const std::vector<AABB>& boxes, std::vector<Index> ids) {
+  ObjectBoxTree tree;
+  tree.ids = std::move(ids);
   std::vector<AABB> own;
-  own.reserve(ids.size());
-  for (Index i : ids) own.push_back(boxes[static_cast<size_t>(i)]);
-  TriangleBvh tree;  // leaf t is ids[t]
-  tree.build(own);
+  own.reserve(tree.ids.size());
+  for (Index i : tree.ids) own.push_back(boxes[static_cast<size_t>(i)]);
+  tree.bvh.build(own);
+  return tree;
+}
+
+const ObjectBoxTree& FrameBoxes::object_tree() const {
+  std::call_once(bvh_cache->object_once, [&] {
+    std::vector<Index> ids;
+    for (size_t i = 0; i < objects.size(); ++i)
+      if (!objects[i].empty()) ids.push_back(static_cast<Index>(i));
+    bvh_cache->object_tree = ObjectBoxTree::build(objects, std::move(ids));
+  });
+  return bvh_cache->object_tree;
+}
+
+std::vector<std::pair<Index, Index>> overlapping_box_pairs(const ObjectBoxTree& tree, const std::vector<AABB>& boxes,
+                                                           int threads) {
+  const std::vector<Index>& ids = tree.ids;
   std::vector<std::vector<Index>> partners(ids.size());
   parallel_for(ids.size(), threads, [&](size_t k) {
     const Index a = ids[k];
-    tree.query_overlaps(own[k], [](std::int32_t) { return false; }, [&](Index t) {
+    tree.bvh.query_overlaps(boxes[static_cast<size_t>(a)], [](std::int32_t) { return false; }, [&](Index t) {
       const Index b = ids[static_cast<size_t>(t)];
       if (a < b) partners[k].push_back(b);
     });

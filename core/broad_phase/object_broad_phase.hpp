@@ -13,6 +13,15 @@
 
 namespace vproxq {
 
+/// A BVH over the boxes of a set of objects: leaf t is object ids[t].
+struct ObjectBoxTree {
+  std::vector<Index> ids;  ///< their boxes must not be empty
+  TriangleBvh bvh;
+
+  /// Over boxes[i] for i in `ids`.
+  static ObjectBoxTree build(const std::vector<AABB>& boxes, std::vector<Index> ids);
+};
+
 /// Triangle and object boxes of one frame, computed once and shared by the stages.
 struct FrameBoxes {
   std::vector<std::vector<AABB>> triangles;  ///< [object][triangle]
@@ -27,6 +36,8 @@ struct FrameBoxes {
   /// Builds the BVHs of the objects for which want(i) holds, on `threads` threads.
   template <typename Want>
   void build_bvhs(int threads, const Want& want) const;
+  /// The BVH of the boxes of the objects with triangles, built on first use (like bvh()).
+  const ObjectBoxTree& object_tree() const;
 
   struct BvhCache;
   std::shared_ptr<BvhCache> bvh_cache;  ///< set by compute()
@@ -36,6 +47,8 @@ struct FrameBoxes::BvhCache {
   explicit BvhCache(std::size_t n) : once(n), bvhs(n) {}
   std::vector<std::once_flag> once;
   std::vector<TriangleBvh> bvhs;
+  std::once_flag object_once;
+  ObjectBoxTree object_tree;
 };
 
 inline const TriangleBvh& FrameBoxes::bvh(std::size_t i) const {
@@ -77,11 +90,11 @@ double rounding_slack(double magnitude);
 /// objects, plus the walks (linear in the candidates' triangles).
 ObjectBroadPhase object_broad_phase(const Frame& frame, const FrameBoxes& boxes, int threads);
 
-/// Pairs (a, b), a < b, of the objects in `ids` whose boxes overlap (boxes_overlap(): closed
-/// boxes, touching included), ascending. Through a hierarchy of the boxes, in parallel: a
-/// sweep along one axis costs the number of boxes sharing a slab of that axis, which in a
-/// crowd grows with the square of the count. The boxes of `ids` must not be empty.
-std::vector<std::pair<Index, Index>> overlapping_box_pairs(const std::vector<AABB>& boxes,
-                                                           const std::vector<Index>& ids, int threads);
+/// Pairs (a, b), a < b, of the objects of `tree` (built over `boxes`) whose boxes overlap
+/// (boxes_overlap(): closed boxes, touching included), ascending. Through the hierarchy, in
+/// parallel: a sweep along one axis costs the number of boxes sharing a slab of that axis,
+/// which in a crowd grows with the square of the count.
+std::vector<std::pair<Index, Index>> overlapping_box_pairs(const ObjectBoxTree& tree, const std::vector<AABB>& boxes,
+                                                           int threads);
 
 }  // namespace vproxq

@@ -28,15 +28,16 @@ SortedAxis::SortedAxis(const std::vector<Index>& objects, const std::vector<AABB
     return la < lb || (la == lb && a < b);
   });
   lo_.reserve(order_.size());
-  hi_.reserve(order_.size());
+  std::vector<double> hi;
+  hi.reserve(order_.size());
   position_.assign(boxes.size(), 0);
   for (std::size_t q = 0; q < order_.size(); ++q) {
     const AABB& b = boxes[static_cast<std::size_t>(order_[q])];
     lo_.push_back(b.lo[k]);
-    hi_.push_back(b.hi[k]);
+    hi.push_back(b.hi[k]);
     position_[static_cast<std::size_t>(order_[q])] = q;
   }
-  hi_max_ = MaxTree(hi_);
+  hi_ = MaxTree(hi);
 }
 
 // For an interval starting at or before i's (lo <= a_lo), the overlap is min(a_hi, hi) - a_lo:
@@ -47,21 +48,21 @@ SortedAxis::SortedAxis(const std::vector<Index>& objects, const std::vector<AABB
 // the full scan's.
 Index SortedAxis::most_overlapping(Index i) const {
   const std::size_t self = position_[static_cast<std::size_t>(i)];
-  const double a_lo = lo_[self], a_hi = hi_[self];
+  const double a_lo = lo_[self], a_hi = hi_.at(self);
   const std::size_t m = order_.size();
   const std::size_t left_end =
       static_cast<std::size_t>(std::upper_bound(lo_.begin(), lo_.end(), a_lo) - lo_.begin());
   double best = -kInfinity;
   std::size_t best_q = m;
-  const double h = std::max(hi_max_.max(0, self), hi_max_.max(self + 1, left_end));
+  const double h = std::max(hi_.max(0, self), hi_.max(self + 1, left_end));
   if (h > -kInfinity) {  // some other interval starts at or before a_lo
     best = std::min(a_hi, h) - a_lo;
     const auto reaches = [&](double x) { return std::min(a_hi, x) - a_lo >= best; };
-    best_q = hi_max_.first(0, self, reaches);
-    if (best_q == self) best_q = hi_max_.first(self + 1, left_end, reaches);
+    best_q = hi_.first(0, self, reaches);
+    if (best_q == self) best_q = hi_.first(self + 1, left_end, reaches);
   }
   for (std::size_t q = left_end; q < m && !(a_hi - lo_[q] < best); ++q) {
-    const double ov = std::min(a_hi, hi_[q]) - lo_[q];
+    const double ov = std::min(a_hi, hi_.at(q)) - lo_[q];
     if (ov > best) {
       best = ov;
       best_q = q;

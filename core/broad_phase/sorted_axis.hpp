@@ -17,6 +17,9 @@ class MaxTree {
   MaxTree() = default;
   explicit MaxTree(const std::vector<double>& values);
 
+  /// The value at position q.
+  double at(std::size_t q) const { return node_[size_ + q]; }
+
   /// Largest value at positions [l, r); -inf when the range is empty.
   double max(std::size_t l, std::size_t r) const;
 
@@ -58,9 +61,9 @@ class SortedAxis {
 
  private:
   std::vector<Index> order_;
-  std::vector<double> lo_, hi_;    ///< interval ends, in sorted order
+  std::vector<double> lo_;             ///< low ends, in sorted order
   std::vector<std::size_t> position_;  ///< [object id] -> index into order_
-  MaxTree hi_max_;
+  MaxTree hi_;                         ///< high ends, in sorted order, with range maxima
 };
 
 }  // namespace vproxq

@@ -321,7 +321,8 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
   std::vector<Index> live;
   for (Index i : sweep.participants.objects)
     if (from.objects[static_cast<size_t>(i)].num_triangles() > 0) live.push_back(i);
-  std::vector<std::pair<Index, Index>> object_pairs = overlapping_box_pairs(sweep.objects, live, threads);
+  std::vector<std::pair<Index, Index>> object_pairs =
+      overlapping_box_pairs(ObjectBoxTree::build(sweep.objects, live), sweep.objects, threads);
   for (Index i : live) object_pairs.emplace_back(i, i);
   std::sort(object_pairs.begin(), object_pairs.end());
   out.counters.object_pairs = object_pairs.size();

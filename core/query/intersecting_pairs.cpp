@@ -40,10 +40,7 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
     const Index nt = frame.objects[static_cast<size_t>(i)].num_triangles();
     for (Index f = 0; f < nt; f += kChunk) items.push_back({i, j, f, std::min(nt, f + kChunk)});
   };
-  std::vector<Index> with_box;  // objects with triangles
-  for (size_t i = 0; i < n; ++i)
-    if (!boxes.objects[i].empty()) with_box.push_back(static_cast<Index>(i));
-  const auto object_pairs = overlapping_box_pairs(boxes.objects, with_box, threads);
+  const auto object_pairs = overlapping_box_pairs(boxes.object_tree(), boxes.objects, threads);
   std::vector<char> needs_bvh(n, 0);
   for (const auto& [i, j] : object_pairs) {
     add_chunks(i, j);

@@ -268,7 +268,7 @@ TEST(OverlappingBoxPairs, EqualsAllPairs) {
         if (boxes_overlap(boxes[static_cast<size_t>(ids[a])], boxes[static_cast<size_t>(ids[b])]))
           expected.emplace_back(ids[a], ids[b]);
     for (int threads : {1, 3})
-      EXPECT_EQ(overlapping_box_pairs(boxes, ids, threads), expected) << "seed " << seed << " threads " << threads;
+      EXPECT_EQ(overlapping_box_pairs(ObjectBoxTree::build(boxes, ids), boxes, threads), expected) << "seed " << seed << " threads " << threads;
   }
 }
 
