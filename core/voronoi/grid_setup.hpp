@@ -41,7 +41,9 @@ struct StageGrid {
   static StageGrid over(const AABB& box, int resolution) {
     StageGrid g;
     const Vec3 ext = box.hi - box.lo;
-    const double longest = std::max(ext.maxCoeff(), 1e-300);
+    // A box of zero extent (every point at one place) still gets cells whose squares, in
+    // extent below, do not underflow to 0 (which would make `unit` 0).
+    const double longest = std::max(ext.maxCoeff(), 0x1p-400);
     g.grid.cell = longest / resolution;
     g.grid.origin = box.lo;
     for (int k = 0; k < 3; ++k)

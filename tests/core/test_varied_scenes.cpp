@@ -82,10 +82,58 @@ Frame next_frame(const Frame& from, const FrameBoxes& boxes, std::uint64_t seed)
   return to;
 }
 
-TEST(VariedScenes, EveryQueryEqualsBruteForce) {
+/// What a comparison exercised, summed over scenes.
+struct Exercised {
+  std::uint64_t intersecting = 0, collisions = 0, intra_pairs = 0;
+};
+
+/// Every query on `frame` (and on `to`, its next frame, for CCD) against its brute force,
+/// without and with Stage II (CPU backends) at `grid`.
+void expect_every_query_equals_brute_force(const Frame& frame, const Frame& to, int threads, int grid,
+                                           Exercised& seen) {
   auto inter_backend = make_cpu_voronoi_backend(2);
   auto self_backend = make_cpu_self_voronoi_backend(2);
-  std::uint64_t intersecting = 0, collisions = 0, intra_pairs = 0;
+  const FrameBoxes boxes = FrameBoxes::compute(frame, threads);
+  const ObjectBroadPhase stage1 = object_broad_phase(frame, boxes, threads);
+
+  const auto inter_ref = inter_object_distance_brute_force(frame);
+  const VoronoiBounds vb = compute_voronoi_bounds(frame, boxes, stage1, *inter_backend, grid, threads);
+  for (const VoronoiBounds* v : {static_cast<const VoronoiBounds*>(nullptr), &vb}) {
+    const auto got = inter_object_distance(frame, boxes, stage1, InterDistanceOptions{threads, v});
+    test::expect_same_inter(got, inter_ref, v ? "inter cpu" : "inter off");
+  }
+
+  const auto intra_ref = intra_object_distance_brute_force(frame);
+  for (const auto& o : intra_ref.per_object) seen.intra_pairs += o.has_pair();
+  const auto ring2 = ring2_upper_bounds(frame, threads);
+  const SelfVoronoiBounds sb = compute_self_voronoi_bounds(frame, boxes, ring2, *self_backend, grid, threads);
+  for (const SelfVoronoiBounds* v : {static_cast<const SelfVoronoiBounds*>(nullptr), &sb})
+    test::expect_same_intra(intra_object_distance(frame, boxes, ring2, IntraDistanceOptions{threads, v}),
+                            intra_ref, v ? "intra cpu" : "intra off");
+
+  const auto pairs_ref = intersecting_pairs_brute_force(frame);
+  seen.intersecting += pairs_ref.pairs.size();
+  for (const VoronoiBounds* v : {static_cast<const VoronoiBounds*>(nullptr), &vb}) {
+    IntersectingPairsOptions opts;
+    opts.threads = threads;
+    opts.voronoi = v;
+    const auto got = intersecting_pairs(frame, boxes, opts);
+    ASSERT_EQ(got.pairs.size(), pairs_ref.pairs.size()) << (v ? "pairs cpu" : "pairs off");
+    for (size_t k = 0; k < got.pairs.size(); ++k) EXPECT_TRUE(got.pairs[k] == pairs_ref.pairs[k]) << "pair " << k;
+  }
+
+  const CcdStepResult ccd_ref = continuous_collisions_brute_force(frame, to);
+  seen.collisions += ccd_ref.vf.size() + ccd_ref.ee.size();
+  const CcdSweep sweep = CcdSweep::compute(frame, to, threads);
+  const CcdVoxelCulling voxels(frame, to, sweep, grid, threads);
+  for (const CcdVoxelCulling* v : {static_cast<const CcdVoxelCulling*>(nullptr), &voxels}) {
+    SCOPED_TRACE(v ? "ccd voxels" : "ccd off");
+    test::expect_same_ccd(continuous_collisions(frame, to, sweep, CcdOptions{threads, v}), ccd_ref);
+  }
+}
+
+TEST(VariedScenes, EveryQueryEqualsBruteForce) {
+  Exercised seen;
   for (std::uint64_t seed = 1; seed <= 40; ++seed) {
     test::Rng rng(seed * 7919);
     Frame frame = scene_of_kind(rng, seed);
@@ -94,49 +142,41 @@ TEST(VariedScenes, EveryQueryEqualsBruteForce) {
     const int grid = 1 + static_cast<int>(std::pow(2.0, rng.uniform(0, 8)));
     SCOPED_TRACE("seed " + std::to_string(seed) + ", threads " + std::to_string(threads) + ", grid " +
                  std::to_string(grid));
-    const FrameBoxes boxes = FrameBoxes::compute(frame, threads);
-    const ObjectBroadPhase stage1 = object_broad_phase(frame, boxes, threads);
-
-    const auto inter_ref = inter_object_distance_brute_force(frame);
-    const VoronoiBounds vb = compute_voronoi_bounds(frame, boxes, stage1, *inter_backend, grid, threads);
-    for (const VoronoiBounds* v : {static_cast<const VoronoiBounds*>(nullptr), &vb}) {
-      const auto got = inter_object_distance(frame, boxes, stage1, InterDistanceOptions{threads, v});
-      test::expect_same_inter(got, inter_ref, v ? "inter cpu" : "inter off");
-    }
-
-    const auto intra_ref = intra_object_distance_brute_force(frame);
-    for (const auto& o : intra_ref.per_object) intra_pairs += o.has_pair();
-    const auto ring2 = ring2_upper_bounds(frame, threads);
-    const SelfVoronoiBounds sb = compute_self_voronoi_bounds(frame, boxes, ring2, *self_backend, grid, threads);
-    for (const SelfVoronoiBounds* v : {static_cast<const SelfVoronoiBounds*>(nullptr), &sb})
-      test::expect_same_intra(intra_object_distance(frame, boxes, ring2, IntraDistanceOptions{threads, v}),
-                              intra_ref, v ? "intra cpu" : "intra off");
-
-    const auto pairs_ref = intersecting_pairs_brute_force(frame);
-    intersecting += pairs_ref.pairs.size();
-    for (const VoronoiBounds* v : {static_cast<const VoronoiBounds*>(nullptr), &vb}) {
-      IntersectingPairsOptions opts;
-      opts.threads = threads;
-      opts.voronoi = v;
-      const auto got = intersecting_pairs(frame, boxes, opts);
-      ASSERT_EQ(got.pairs.size(), pairs_ref.pairs.size()) << (v ? "pairs cpu" : "pairs off");
-      for (size_t k = 0; k < got.pairs.size(); ++k) EXPECT_TRUE(got.pairs[k] == pairs_ref.pairs[k]) << "pair " << k;
-    }
-
-    const Frame to = next_frame(frame, boxes, seed);
-    const CcdStepResult ccd_ref = continuous_collisions_brute_force(frame, to);
-    collisions += ccd_ref.vf.size() + ccd_ref.ee.size();
-    const CcdSweep sweep = CcdSweep::compute(frame, to, threads);
-    const CcdVoxelCulling voxels(frame, to, sweep, grid, threads);
-    for (const CcdVoxelCulling* v : {static_cast<const CcdVoxelCulling*>(nullptr), &voxels}) {
-      SCOPED_TRACE(v ? "ccd voxels" : "ccd off");
-      test::expect_same_ccd(continuous_collisions(frame, to, sweep, CcdOptions{threads, v}), ccd_ref);
-    }
+    const Frame to = next_frame(frame, FrameBoxes::compute(frame, threads), seed);
+    expect_every_query_equals_brute_force(frame, to, threads, grid, seen);
   }
   // The scenes exercise what they compare: intersections, collisions and self pairs.
-  EXPECT_GT(intersecting, 1000u);
-  EXPECT_GT(collisions, 1000u);
-  EXPECT_GT(intra_pairs, 100u);
+  EXPECT_GT(seen.intersecting, 1000u);
+  EXPECT_GT(seen.collisions, 1000u);
+  EXPECT_GT(seen.intra_pairs, 100u);
+}
+
+// Scenes whose every vertex sits at one point, or on one line, in one or both frames: the
+// scene box has no extent along some or all axes. Stage II once derived a zero length unit
+// from such a box (the square of its tiny cell underflowed) and crashed.
+TEST(VariedScenes, ScenesCollapsedToAPointOrALineEqualBruteForce) {
+  Exercised seen;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    test::Rng rng(seed * 104729);
+    const Frame base = scene_of_kind(rng, seed);
+    const Vec3 at = seed % 3 == 0 ? Vec3(Vec3::Zero()) : Vec3(Vec3(1, -2, 3) * std::pow(10.0, rng.uniform(-5, 5)));
+    Frame point = base, line = base;
+    for (Object& o : point.objects)
+      for (Vec3& p : o.positions) p = at;
+    for (Object& o : line.objects)
+      for (Vec3& p : o.positions) p = Vec3(p.x(), at.y(), at.z());
+    point.index = line.index = 0;
+    for (const Frame* frame : {&point, &line}) {
+      SCOPED_TRACE(std::string(frame == &point ? "point" : "line") + ", seed " + std::to_string(seed));
+      Frame to = *frame;
+      to.index = 1;
+      for (int grid : {0, 64}) expect_every_query_equals_brute_force(*frame, to, 2, grid, seen);
+      // Unfolding from the point into the scene: CCD over a step that starts with no extent.
+      if (frame == &point) expect_every_query_equals_brute_force(*frame, base, 2, 0, seen);
+    }
+  }
+  EXPECT_GT(seen.intersecting, 0u);
+  EXPECT_GT(seen.collisions, 0u);
 }
 
 /// `v` times 2^k (exact in double while the result stays in the normal range).
