@@ -44,6 +44,12 @@ Ownership ownership(const Topology& topo) {
 
 bool in_face(Index v, const Face& f) { return f[0] == v || f[1] == v || f[2] == v; }
 
+/// Whether entry k of a triangle's corners or edge ids repeats an earlier one (a face with a
+/// repeated vertex lists that vertex twice and its one real edge twice): each is tested once.
+bool repeats_earlier(const std::array<Index, 3>& a, size_t k) {
+  return (k >= 1 && a[k] == a[0]) || (k == 2 && a[2] == a[1]);
+}
+
 bool share_endpoint(const std::array<Index, 2>& a, const std::array<Index, 2>& b) {
   return a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1];
 }
@@ -421,18 +427,22 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
           return;
         }
         const AABB& gb = tb_j[static_cast<size_t>(g)];
-        for (Index v : ff)
-          if (own_i.vertex[static_cast<size_t>(v)] == f) vertex_face(i, vb_i, v, j, gf, g, gb);
-        for (Index w : gf)
-          if (own_j.vertex[static_cast<size_t>(w)] == g) vertex_face(j, vb_j, w, i, ff, f, fb);
+        for (size_t k = 0; k < 3; ++k)
+          if (own_i.vertex[static_cast<size_t>(ff[k])] == f && !repeats_earlier(ff, k))
+            vertex_face(i, vb_i, ff[k], j, gf, g, gb);
+        for (size_t k = 0; k < 3; ++k)
+          if (own_j.vertex[static_cast<size_t>(gf[k])] == g && !repeats_earlier(gf, k))
+            vertex_face(j, vb_j, gf[k], i, ff, f, fb);
         const auto& fe = adj_i.triangle_edges(f);
         const auto& ge = adj_j.triangle_edges(g);
-        for (Index ea : fe) {
-          if (ea == kNoIndex || own_i.edge[static_cast<size_t>(ea)] != f) continue;
+        for (size_t ka = 0; ka < 3; ++ka) {
+          const Index ea = fe[ka];
+          if (ea == kNoIndex || own_i.edge[static_cast<size_t>(ea)] != f || repeats_earlier(fe, ka)) continue;
           const auto& va = adj_i.edges()[static_cast<size_t>(ea)];
           const AABB ba = edge_box(vb_i, va);
-          for (Index eb : ge) {
-            if (eb == kNoIndex || own_j.edge[static_cast<size_t>(eb)] != g) continue;
+          for (size_t kb = 0; kb < 3; ++kb) {
+            const Index eb = ge[kb];
+            if (eb == kNoIndex || own_j.edge[static_cast<size_t>(eb)] != g || repeats_earlier(ge, kb)) continue;
             const auto& vb = adj_j.edges()[static_cast<size_t>(eb)];
             if (self && share_endpoint(va, vb)) continue;
             AABB bb = edge_box(vb_j, vb);

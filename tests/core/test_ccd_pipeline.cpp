@@ -144,5 +144,65 @@ TEST(CcdPipeline, IncidentPairsAreExcludedButNeighboursAreTested) {
   EXPECT_EQ(r.pairs[0].objects, (std::array<Index, 2>{0, 0}));
 }
 
+TEST(CcdPipeline, FacesWithARepeatedVertexTestEachPrimitivePairOnce) {
+  // A face (a, a, b) lists vertex a twice and its one edge {a, b} twice; each primitive pair
+  // is still tested and reported once, as the brute force (which walks vertices and edges)
+  // does. Object 0 is such a face on the segment (0,0,0)-(1,0,0); object 1's edge crosses it
+  // at t = 0.5, and object 0's vertex 1 drops through object 1's big triangle.
+  auto seg = std::make_shared<Topology>();
+  seg->num_vertices = 2;
+  seg->faces = {{0, 0, 1}};
+  auto tri = std::make_shared<Topology>();
+  tri->num_vertices = 3;
+  tri->faces = {{0, 1, 2}};
+  Object a, b;
+  a.name = "segment";
+  a.topology = seg;
+  a.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0)};
+  b.name = "triangle";
+  b.topology = tri;
+  b.positions = {Vec3(0.5, -0.5, 0.5), Vec3(0.5, 0.5, 0.5), Vec3(0.5, 0, 1.5)};
+  Object a1 = a, b1 = b;
+  for (Vec3& p : b1.positions) p.z() -= 1.0;
+  Frame from, to;
+  from.objects = {a, b};
+  to.objects = {a1, b1};
+  to.index = 1;
+  const CcdStepResult edges = continuous_collisions(from, to, CcdOptions{1, nullptr});
+  ASSERT_EQ(edges.ee.size(), 1u);
+  EXPECT_EQ(edges.ee[0].object_a, 0);
+  EXPECT_EQ(edges.ee[0].object_b, 1);
+  expect_same_ccd(edges, continuous_collisions_brute_force(from, to));
+
+  Object floor = b;
+  floor.positions = {Vec3(-5, -5, 0), Vec3(5, -5, 0), Vec3(0, 5, 0)};
+  a.positions = {Vec3(0, 0, 1), Vec3(1, 0, 1)};
+  a1.positions = {Vec3(0, 0, 1), Vec3(1, 0, -1)};
+  from.objects = {a, floor};
+  to.objects = {a1, floor};
+  const CcdStepResult vertex = continuous_collisions(from, to, CcdOptions{1, nullptr});
+  ASSERT_EQ(vertex.vf.size(), 1u);
+  EXPECT_EQ(vertex.vf[0].vertex, 1);
+  expect_same_ccd(vertex, continuous_collisions_brute_force(from, to));
+
+  // Random scenes with a third of the faces collapsed onto one of their edges.
+  std::size_t hits = 0;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    Frame f = test::make_random_frame(seed, 4, 1.5, 1);
+    f.index = 0;
+    for (Object& o : f.objects) {
+      auto t = std::make_shared<Topology>(*o.topology);
+      for (size_t k = 0; k < t->faces.size(); k += 3) t->faces[k][k % 2 == 0 ? 2 : 0] = t->faces[k][1];
+      o.topology = t;
+    }
+    const Frame g = moved(f, seed * 17, 0.6, 0.25);
+    const CcdStepResult ref = continuous_collisions_brute_force(f, g);
+    hits += ref.vf.size() + ref.ee.size();
+    expect_same_ccd(continuous_collisions(f, g, CcdOptions{2, nullptr}), ref);
+  }
+  EXPECT_GT(hits, 0u);
+}
+
 }  // namespace
 }  // namespace vproxq
