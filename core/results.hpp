@@ -192,6 +192,9 @@ struct CcdCounters {
   std::uint64_t triangle_pairs = 0;   ///< candidate triangle pairs after culling
   /// Of those, pairs shown apart for the whole step along a separating axis (no tests ran).
   std::uint64_t separated_pairs = 0;
+  /// Primitive pairs (vertex–face, edge–edge) shown apart for the whole step along a
+  /// separating axis (no test ran).
+  std::uint64_t separated_primitives = 0;
   std::uint64_t vf_tests = 0;         ///< elementary vertex–face tests run
   std::uint64_t ee_tests = 0;         ///< elementary edge–edge tests run
   std::uint64_t limit_hits = 0;       ///< tests reported at the kernel's box limit

@@ -55,10 +55,11 @@ bool share_endpoint(const std::array<Index, 2>& a, const std::array<Index, 2>& b
 }
 
 /// A triangle's corners at the start and at the end of the step, with the axes it offers to
-/// swept_apart(): its normal at the start and the sum of its corners at the start.
+/// swept_apart(): its normal at the start and the sum of its corners at the start; and its
+/// normal at the end (for primitives_apart()).
 struct SweptTriangle {
   std::array<Vec3, 3> start, end;
-  Vec3 normal, corner_sum;
+  Vec3 normal, corner_sum, normal_end;
 };
 
 std::vector<SweptTriangle> swept_triangles(const Object& from, const Object& to) {
@@ -72,6 +73,7 @@ std::vector<SweptTriangle> swept_triangles(const Object& from, const Object& to)
     }
     s.normal = (s.start[1] - s.start[0]).cross(s.start[2] - s.start[0]);
     s.corner_sum = s.start[0] + s.start[1] + s.start[2];
+    s.normal_end = (s.end[1] - s.end[0]).cross(s.end[2] - s.end[0]);
   }
   return out;
 }
@@ -94,6 +96,45 @@ bool swept_apart(const SweptTriangle& a, const SweptTriangle& b, double gap) {
     return d > 0 && d * d > gap * gap * w.squaredNorm();
   };
   return apart_along(a.normal) || apart_along(b.normal) || apart_along(b.corner_sum - a.corner_sum);
+}
+
+/// A vertex and a face's corners (NA = 1, NB = 3) or two edges' end points (2, 2), at the
+/// start and at the end of the step.
+template <std::size_t NA, std::size_t NB>
+struct SweptPrimitives {
+  std::array<Vec3, NA> a_start, a_end;
+  std::array<Vec3, NB> b_start, b_end;
+};
+
+/// Whether two primitives stay more than `gap` apart for the whole step, shown along x, y, z
+/// or one of `axes`: swept_apart()'s argument, with the primitives' own points (every point of
+/// a primitive is a convex combination of them, so its projection lies between theirs). A
+/// pair this rules out is one the elementary test cannot report (gap: see apart_gap below).
+/// Along a coordinate axis the projections are the coordinates themselves (exact).
+template <std::size_t NA, std::size_t NB>
+bool primitives_apart(const SweptPrimitives<NA, NB>& p, std::initializer_list<Vec3> axes, double gap) {
+  auto apart_along = [&](const Vec3& w) {
+    auto gaps = [&](const std::array<Vec3, NA>& a, const std::array<Vec3, NB>& b) {
+      double a_lo = kInfinity, a_hi = -kInfinity, b_lo = kInfinity, b_hi = -kInfinity;
+      for (const Vec3& x : a) {
+        a_lo = std::min(a_lo, w.dot(x));
+        a_hi = std::max(a_hi, w.dot(x));
+      }
+      for (const Vec3& x : b) {
+        b_lo = std::min(b_lo, w.dot(x));
+        b_hi = std::max(b_hi, w.dot(x));
+      }
+      return ProjectionGaps{b_lo - a_hi, a_lo - b_hi};
+    };
+    const ProjectionGaps g0 = gaps(p.a_start, p.b_start), g1 = gaps(p.a_end, p.b_end);
+    const double d = std::max(std::min(g0.b_above_a, g1.b_above_a), std::min(g0.a_above_b, g1.a_above_b));
+    return d > 0 && d * d > gap * gap * w.squaredNorm();
+  };
+  for (int k = 0; k < 3; ++k)
+    if (apart_along(Vec3::Unit(k))) return true;
+  for (const Vec3& w : axes)
+    if (apart_along(w)) return true;
+  return false;
 }
 
 /// Per object: each triangle's box at the start and at the end of the step, and their unions
@@ -198,6 +239,7 @@ void add(CcdCounters& a, const CcdCounters& b) {
   a.limit_hits += b.limit_hits;
   a.culled_triangles += b.culled_triangles;
   a.separated_pairs += b.separated_pairs;
+  a.separated_primitives += b.separated_primitives;
 }
 
 /// Sorts the hits canonically and summarises them per object pair.
@@ -364,6 +406,8 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
     const Index i = task.i, j = task.j;
     const Object& oi = from.objects[static_cast<size_t>(i)];
     const Object& oj = from.objects[static_cast<size_t>(j)];
+    const Object& ti = to.objects[static_cast<size_t>(i)];
+    const Object& tj = to.objects[static_cast<size_t>(j)];
     const Adjacency& adj_i = adjacency(*oi.topology);
     const Adjacency& adj_j = adjacency(*oj.topology);
     const Ownership& own_i = owners[static_cast<size_t>(i)];
@@ -392,10 +436,17 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
 
     // Vertex v of object ov (owned by tri fv) against face g of object og.
     auto vertex_face = [&](Index ov, const std::vector<AABB>& v_boxes, Index v, Index og,
-                           const Face& g_face, Index g, const AABB& g_box) {
+                           const Face& g_face, Index g, const AABB& g_box, const SweptTriangle& g_swept) {
       if (self && in_face(v, g_face)) return;
       // The vertex's own swept box against the face's widened one: exact comparisons.
       if (!boxes_overlap(v_boxes[static_cast<size_t>(v)], g_box)) return;
+      const SweptPrimitives<1, 3> p{{from.objects[static_cast<size_t>(ov)].positions[static_cast<size_t>(v)]},
+                                    {to.objects[static_cast<size_t>(ov)].positions[static_cast<size_t>(v)]},
+                                    g_swept.start, g_swept.end};
+      if (primitives_apart(p, {g_swept.normal, g_swept.normal_end}, apart_gap)) {
+        ++hits.counters.separated_primitives;
+        return;
+      }
       tester.vertex_face(ov, v, og, g, hits);
     };
 
@@ -427,12 +478,13 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
           return;
         }
         const AABB& gb = tb_j[static_cast<size_t>(g)];
+        const SweptTriangle& swept_g = swept_j[static_cast<size_t>(g)];
         for (size_t k = 0; k < 3; ++k)
           if (own_i.vertex[static_cast<size_t>(ff[k])] == f && !repeats_earlier(ff, k))
-            vertex_face(i, vb_i, ff[k], j, gf, g, gb);
+            vertex_face(i, vb_i, ff[k], j, gf, g, gb, swept_g);
         for (size_t k = 0; k < 3; ++k)
           if (own_j.vertex[static_cast<size_t>(gf[k])] == g && !repeats_earlier(gf, k))
-            vertex_face(j, vb_j, gf[k], i, ff, f, fb);
+            vertex_face(j, vb_j, gf[k], i, ff, f, fb, swept_f);
         const auto& fe = adj_i.triangle_edges(f);
         const auto& ge = adj_j.triangle_edges(g);
         for (size_t ka = 0; ka < 3; ++ka) {
@@ -449,6 +501,16 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
             bb.lo.array() -= sweep.margin;
             bb.hi.array() += sweep.margin;
             if (!boxes_overlap(ba, bb)) continue;
+            auto ends = [](const Object& o, const std::array<Index, 2>& e) {
+              return std::array<Vec3, 2>{o.positions[static_cast<size_t>(e[0])], o.positions[static_cast<size_t>(e[1])]};
+            };
+            const SweptPrimitives<2, 2> p{ends(oi, va), ends(ti, va), ends(oj, vb), ends(tj, vb)};
+            const Vec3 cross_start = (p.a_start[1] - p.a_start[0]).cross(p.b_start[1] - p.b_start[0]);
+            const Vec3 cross_end = (p.a_end[1] - p.a_end[0]).cross(p.b_end[1] - p.b_end[0]);
+            if (primitives_apart(p, {cross_start, cross_end}, apart_gap)) {
+              ++hits.counters.separated_primitives;
+              continue;
+            }
             // Canonical order: the smaller (object, edge id) first.
             if (i < j || (self && ea < eb))
               tester.edge_edge(i, va, j, vb, hits);

@@ -9,7 +9,8 @@
 // below), sweep-and-prune over the swept object boxes, then per object pair a BVH over the
 // swept triangle boxes gives the candidate triangle pairs; a subtree or a pair that a
 // separating axis shows apart by more than twice the margin at both ends of the step (hence
-// throughout it: ccd.cpp) is skipped. Optional Stage II
+// throughout it: ccd.cpp) is skipped, and so is each primitive pair of the remaining triangle
+// pairs that the same argument shows apart (CcdCounters::separated_primitives). Optional Stage II
 // (core/voronoi/ccd_stage2.hpp) culls them further with a voxelization of the swept prisms.
 // Stage III: the elementary tests of core/geometry/ccd.hpp, each vertex–face and edge–edge pair
 // tested once (see ccd.cpp for the ownership rule that deduplicates without a global set).

@@ -19,7 +19,8 @@ using test::expect_same_ccd;
 using test::moved;
 
 TEST(CcdPipeline, RandomStepsEqualBruteForceWithEveryCulling) {
-  std::uint64_t inter = 0, intra = 0, tests_off = 0, tests_vox = 0, brute_tests = 0, separated = 0;
+  std::uint64_t inter = 0, intra = 0, tests_off = 0, tests_vox = 0, brute_tests = 0, separated = 0,
+                separated_primitives = 0;
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     Frame from = test::make_random_frame(seed, 5, 3.0, 1);
@@ -34,6 +35,7 @@ TEST(CcdPipeline, RandomStepsEqualBruteForceWithEveryCulling) {
       expect_same_ccd(r, ref);
       if (threads == 1) tests_off += r.counters.elementary_tests();
       if (threads == 1) separated += r.counters.separated_pairs;
+      if (threads == 1) separated_primitives += r.counters.separated_primitives;
       const CcdSweep sweep = CcdSweep::compute(from, to, threads);
       for (int grid : {4, 16, 64}) {
         SCOPED_TRACE("grid " + std::to_string(grid));
@@ -50,12 +52,15 @@ TEST(CcdPipeline, RandomStepsEqualBruteForceWithEveryCulling) {
   // Candidate pairs whose swept boxes overlap but that a separating axis keeps apart for the
   // whole step are skipped, which the equality above checks loses nothing.
   EXPECT_GT(separated, 0u);
+  // Likewise primitive pairs of the remaining triangle pairs.
+  EXPECT_GT(separated_primitives, 0u);
   std::printf("[          ] colliding primitive pairs: inter %llu, intra %llu; elementary tests: "
               "brute force %llu, AABB culling %llu, voxels (grid 64) %llu; separated triangle "
-              "pairs %llu\n",
+              "pairs %llu, primitive pairs %llu\n",
               static_cast<unsigned long long>(inter), static_cast<unsigned long long>(intra),
               static_cast<unsigned long long>(brute_tests), static_cast<unsigned long long>(tests_off),
-              static_cast<unsigned long long>(tests_vox), static_cast<unsigned long long>(separated));
+              static_cast<unsigned long long>(tests_vox), static_cast<unsigned long long>(separated),
+              static_cast<unsigned long long>(separated_primitives));
 }
 
 TEST(CcdPipeline, TriangleSoupsEqualBruteForce) {
@@ -202,6 +207,41 @@ TEST(CcdPipeline, FacesWithARepeatedVertexTestEachPrimitivePairOnce) {
     expect_same_ccd(continuous_collisions(f, g, CcdOptions{2, nullptr}), ref);
   }
   EXPECT_GT(hits, 0u);
+}
+
+TEST(CcdPipeline, NearMissesWithinTheKernelToleranceAreKept) {
+  // A triangle drops through the plane of a fixed one, its corner q passing a distance h
+  // outside the fixed triangle's hypotenuse, h a fraction of the kernel's tolerance δ. The
+  // kernel reports such pairs (they come within δ), so no culling may drop them although the
+  // primitives never touch: a culling direction in the floor's plane across the hypotenuse
+  // (which none of the separating-axis tests uses) would, unless it asked for a gap above the
+  // culling margin.
+  for (const double fraction : {0.05, 0.2}) {
+    SCOPED_TRACE("h = " + std::to_string(fraction) + " δ");
+    auto floor_topo = std::make_shared<Topology>();
+    floor_topo->num_vertices = 3;
+    floor_topo->faces = {{0, 1, 2}};
+    Object floor;
+    floor.name = "floor";
+    floor.topology = floor_topo;
+    floor.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+    // Every query's extent is at least 1, so δ >= 1e-6 (kCcdRelativeTolerance).
+    const double s = fraction * 1e-6 / std::sqrt(2.0);
+    const Vec3 q(0.5 + s, 0.5 + s, 0.5);
+    Object dropper;
+    dropper.name = "dropper";
+    dropper.topology = std::make_shared<Topology>(*floor_topo);
+    dropper.positions = {q, q + Vec3(1, 0, 0), q + Vec3(0, 1, 0)};
+    Object dropped = dropper;
+    for (Vec3& p : dropped.positions) p.z() -= 1.0;
+    Frame from, to;
+    from.objects = {floor, dropper};
+    to.objects = {floor, dropped};
+    to.index = 1;
+    const CcdStepResult ref = continuous_collisions_brute_force(from, to);
+    EXPECT_FALSE(ref.vf.empty() && ref.ee.empty()) << "the kernel reports no near miss here";
+    for (int threads : {1, 2}) expect_same_ccd(continuous_collisions(from, to, CcdOptions{threads, nullptr}), ref);
+  }
 }
 
 }  // namespace
