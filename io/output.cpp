@@ -47,6 +47,9 @@ class TempPath {
     path_.clear();
   }
 
+  /// Forgets the path: nothing is removed on destruction.
+  void release() { path_.clear(); }
+
  private:
   fs::path path_;
 };
@@ -160,9 +163,38 @@ void ResultWriter::commit() {
   m.json->close();
   m.h5->close();
   sync_file(m.h5_temp.path());
+  const fs::path h5_final = m.dir / kHdf5Name, json_final = m.dir / kJsonName;
+  for (const fs::path& target : {h5_final, json_final}) {
+    std::error_code ec;
+    const fs::file_status st = fs::symlink_status(target, ec);
+    if (fs::exists(st) && !fs::is_regular_file(st)) {
+      throw RuntimeError("cannot write '" + target.string() + "': it exists and is not a regular file");
+    }
+  }
   // results.json last: its presence means that results.h5 of the same run is in place too.
-  m.h5_temp.move_to(m.dir / kHdf5Name);
-  m.json_temp.move_to(m.dir / kJsonName);
+  // An earlier results.h5 is moved aside first and put back should results.json fail to
+  // move into place, so that a failed commit leaves the earlier pair as it was.
+  TempPath previous_h5(temp_name(m.dir, "results.h5.previous"));
+  std::error_code ec;
+  fs::rename(h5_final, previous_h5.path(), ec);
+  const bool had_previous = !ec;
+  if (!had_previous) previous_h5.release();  // nothing there to remove
+  m.h5_temp.move_to(h5_final);
+  try {
+    m.json_temp.move_to(json_final);
+  } catch (const RuntimeError& e) {
+    std::string kept;
+    std::error_code restore;
+    if (had_previous) {
+      const fs::path aside = previous_h5.path();
+      fs::rename(aside, h5_final, restore);
+      previous_h5.release();  // restored, or left where it is rather than lost
+      if (restore) kept = "; the earlier results.h5 is left as '" + aside.string() + "'";
+    } else {
+      fs::remove(h5_final, restore);
+    }
+    throw RuntimeError(e.what() + kept);
+  }
   m.failed = false;
   m.committed = true;
   m.created_dirs.keep();

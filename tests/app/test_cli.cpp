@@ -239,6 +239,32 @@ TEST(Cli, FailureKeepsEarlierResultsIntact) {
   EXPECT_TRUE(fs::exists(out / "results.h5"));
 }
 
+// A results.json that cannot be replaced (here a directory in its place) fails the run before
+// anything is moved into place: no new results.h5 beside the old results.json, no temporaries.
+TEST(Cli, AnOutputNameTakenByADirectoryFailsWithoutReplacingAnything) {
+  ScratchDir dir;
+  const auto scene = kSamples / "two-cubes" / "scene.json";
+  const auto out = dir / "out";
+  auto r = vproxq(quote(scene) + " -o " + quote(out) + " --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string h5_before = slurp(out / "results.h5");
+  fs::remove(out / "results.json");
+  fs::create_directory(out / "results.json");
+  r = vproxq(quote(scene) + " --queries distance,pd -o " + quote(out) + " --quiet");
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  EXPECT_NE(r.output.find("results.json"), std::string::npos) << r.output;
+  EXPECT_EQ(slurp(out / "results.h5"), h5_before);
+  for (const auto& entry : fs::directory_iterator(out))
+    EXPECT_TRUE(entry.path().filename() == "results.h5" || entry.path().filename() == "results.json")
+        << entry.path();
+
+  // With no earlier results.h5, none is left behind.
+  fs::remove(out / "results.h5");
+  r = vproxq(quote(scene) + " -o " + quote(out) + " --quiet");
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  EXPECT_FALSE(fs::exists(out / "results.h5"));
+}
+
 TEST(Cli, SampleScenesEqualBruteForce) {
   for (const char* name : {"two-cubes", "blobs-small"}) {
     SCOPED_TRACE(name);
