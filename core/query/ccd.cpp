@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <map>
 #include <tuple>
+#include <unordered_map>
 
 namespace vproxq {
 namespace {
@@ -276,6 +277,7 @@ constexpr Index kChunk = 256;  ///< triangles per unit of parallel work
 
 CcdParticipants ccd_participants(const Frame& from, const Frame& to) {
   CcdParticipants p;
+  std::unordered_map<std::string, size_t> to_names;  // built when first needed
   for (size_t i = 0; i < from.objects.size(); ++i) {
     const Object& a = from.objects[i];
     const Index id = static_cast<Index>(i);
@@ -285,6 +287,21 @@ CcdParticipants ccd_participants(const Frame& from, const Frame& to) {
       continue;
     }
     const Object& b = to.objects[i];
+    if (a.name != b.name) {
+      // Objects are matched by position. When this object's name is found at another
+      // position of the next frame (and not here), the files list their objects in another
+      // order: the vertices here belong to another object. (A name that changes but is not
+      // found elsewhere, e.g. one taken from each frame's file name, says nothing.)
+      if (to_names.empty())
+        for (size_t k = to.objects.size(); k-- > 0;) to_names[to.objects[k].name] = k;  // first wins
+      const auto moved = to_names.find(a.name);
+      if (moved != to_names.end()) {
+        p.skipped.push_back({id, "'" + a.name + "' is object " + std::to_string(moved->second) + " of frame " +
+                                     std::to_string(to.index) + ", '" + b.name +
+                                     "' takes its place (objects are matched by position)"});
+        continue;
+      }
+    }
     if (a.topology != b.topology && *a.topology != *b.topology) {
       std::string reason = "topology changes between frames " + std::to_string(from.index) +
                            " and " + std::to_string(to.index);

@@ -4,7 +4,8 @@
 // inter-object and intra-object, with its earliest time of impact.
 //
 // Pipeline: objects are matched by position in the frames' lists; an object whose counterpart
-// is missing or whose topology differs is skipped for the step (CcdStepResult::skipped).
+// is missing, whose topology differs or whose name is found at another position of the next
+// frame (objects listed in another order) is skipped for the step (CcdStepResult::skipped).
 // Stage I: swept boxes (the box of a triangle's 6 positions, widened by the culling margin
 // below), sweep-and-prune over the swept object boxes, then per object pair a BVH over the
 // swept triangle boxes gives the candidate triangle pairs; a subtree or a pair that a

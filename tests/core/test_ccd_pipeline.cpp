@@ -118,6 +118,26 @@ TEST(CcdPipeline, TopologyChangeAndMissingObjectAreSkipped) {
   EXPECT_EQ(r.to_frame, 1);
 }
 
+// Objects are matched by position; files that list the same objects in another order would
+// pair unrelated vertices and report collisions where nothing moves. A name that merely
+// changes (names taken from each frame's file name) is no mismatch.
+TEST(CcdPipeline, ObjectsListedInAnotherOrderAreSkipped) {
+  Frame from = test::make_random_frame(5, 3, 1.0, 1);
+  from.index = 0;
+  Frame to = from;
+  to.index = 1;
+  std::swap(to.objects[0], to.objects[1]);
+  to.objects[2].name = "renamed";
+  const CcdStepResult r = continuous_collisions(from, to, CcdOptions{2, nullptr});
+  ASSERT_EQ(r.skipped.size(), 2u);
+  EXPECT_EQ(r.skipped[0].object, 0);
+  EXPECT_EQ(r.skipped[1].object, 1);
+  EXPECT_NE(r.skipped[0].reason.find("'" + from.objects[0].name + "' is object 1 of frame 1"), std::string::npos)
+      << r.skipped[0].reason;
+  EXPECT_TRUE(r.vf.empty() && r.ee.empty());
+  expect_same_ccd(r, continuous_collisions_brute_force(from, to));
+}
+
 TEST(CcdPipeline, IncidentPairsAreExcludedButNeighboursAreTested) {
   // Two triangles sharing vertex 0; the tip of the second (vertex 3) swings through the first.
   auto topo = std::make_shared<Topology>();
