@@ -72,6 +72,9 @@ std::vector<CcdQuery> read_ccd_queries(const std::filesystem::path& file) {
       if (!std::isfinite(p[k]))
         fail(file, line, std::string("coordinate ") + io_detail::axis_name(k) + " is not a finite double");
     }
+    // The kernel's guarantees hold for the coordinate range every reader enforces.
+    if (const std::string problem = io_detail::coordinate_problem(p); !problem.empty())
+      fail(file, line, "the point " + problem);
     if (fields[6] != "0" && fields[6] != "1")
       fail(file, line, "truth (field 7) must be 0 or 1, found '" + io_detail::abbreviate(fields[6]) + "'");
     const bool truth = fields[6] == "1";
