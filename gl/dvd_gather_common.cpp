@@ -18,10 +18,6 @@ double dvd_input_extent(const DvdInput& in) {
 }
 
 void check_dvd_addressable(const DvdInput& in, const std::string& who) {
-  if (in.grid.voxel_count() > std::int64_t{std::numeric_limits<std::uint32_t>::max()}) {
-    throw std::invalid_argument(who + ": the grid has " + std::to_string(in.grid.voxel_count()) +
-                                " voxels; the shader addresses at most 2^32 - 1");
-  }
   for (const std::int32_t d : in.grid.dims) {
     if (d >= (1 << 23)) {
       throw std::invalid_argument(who + ": a grid side of " + std::to_string(d) +
@@ -78,10 +74,14 @@ void DvdSharedBuffers::bind() const {
 }
 
 std::vector<std::uint32_t> pack_samples(const DvdInput& in, std::size_t first, std::size_t count) {
-  std::vector<std::uint32_t> samples(2 * count);
+  std::vector<std::uint32_t> samples(4 * count);
+  const std::int64_t dx = in.grid.dims[0], dy = in.grid.dims[1];
   for (std::size_t k = 0; k < count; ++k) {
-    samples[2 * k] = static_cast<std::uint32_t>(in.voxels[first + k]);
-    std::memcpy(&samples[2 * k + 1], &in.band[first + k], sizeof(float));
+    const std::int64_t id = in.voxels[first + k];
+    samples[4 * k] = static_cast<std::uint32_t>(id % dx);
+    samples[4 * k + 1] = static_cast<std::uint32_t>((id / dx) % dy);
+    samples[4 * k + 2] = static_cast<std::uint32_t>(id / (dx * dy));
+    std::memcpy(&samples[4 * k + 3], &in.band[first + k], sizeof(float));
   }
   return samples;
 }

@@ -17,7 +17,7 @@ namespace vproxq::gl {
 double dvd_input_extent(const DvdInput& in);
 
 /// Throws std::invalid_argument (prefixed with `who`) when the shaders cannot address the
-/// grid exactly (2^32 voxels, 2^23 per side) or the float and double triangles differ in size.
+/// grid exactly (2^23 voxels per side) or the float and double triangles differ in size.
 void check_dvd_addressable(const DvdInput& in, const std::string& who);
 
 /// Splits `count` samples into dispatches of at most GL_MAX_COMPUTE_WORK_GROUP_COUNT[0] groups
@@ -37,7 +37,8 @@ struct DvdSharedBuffers {
   void bind() const;
 };
 
-/// Binding 4 of a batch: per sample, the linear voxel id and the float bits of its band.
+/// Binding 4 of a batch: per sample, its voxel coordinates (x, y, z) and the float bits of its
+/// band.
 std::vector<std::uint32_t> pack_samples(const DvdInput& in, std::size_t first, std::size_t count);
 
 /// The grid and bin uniforms, and the prefilter margin: twice `error_bound`, rounded up to

@@ -35,7 +35,7 @@ class GlVoronoiBackend final : public DiscreteVoronoiBackend {
   /// float32_error_bound(extent).
   double distance_error_bound(double extent) const override;
   /// Throws std::invalid_argument for inconsistent input (validate_dvd_input()) or a grid the
-  /// shader cannot address (more than 2^32 - 1 voxels, or a side of 2^23 voxels or more),
+  /// shader cannot address (a side of 2^23 voxels or more),
   /// GlError when a buffer exceeds GL_MAX_SHADER_STORAGE_BLOCK_SIZE or a GL call fails.
   /// upload_ms includes building the per-triangle info on the host.
   DvdOutput compute(const DvdInput& in) override;

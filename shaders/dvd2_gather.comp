@@ -9,8 +9,8 @@
 //                             first bin its bounding box overlaps (to visit it only once)
 //   binding 2  bin_offsets    CSR offsets, bin count + 1 ints
 //   binding 3  bin_triangles  triangle ids, bin after bin
-//   binding 4  samples        uvec2 per sample voxel of this batch: linear voxel id, band (float
-//                             bits)
+//   binding 4  samples        uvec4 per sample voxel of this batch: its voxel coordinates
+//                             (x, y, z) and its band (float bits)
 //   binding 5  results        ivec4 per sample voxel of this batch: site1, site2, and the float
 //                             bits of dist1, dist2 (site -1 and dist = band when none)
 //   binding 8  exclude_sites  int per sample voxel of this batch: a site whose triangles are
@@ -28,7 +28,7 @@ layout(std430, binding = 0) readonly buffer Triangles { float triangles[]; };
 layout(std430, binding = 1) readonly buffer TriangleInfo { ivec4 triangle_info[]; };
 layout(std430, binding = 2) readonly buffer BinOffsets { int bin_offsets[]; };
 layout(std430, binding = 3) readonly buffer BinTriangles { int bin_triangles[]; };
-layout(std430, binding = 4) readonly buffer Samples { uvec2 samples[]; };
+layout(std430, binding = 4) readonly buffer Samples { uvec4 samples[]; };
 layout(std430, binding = 5) writeonly buffer Results { ivec4 results[]; };
 layout(std430, binding = 8) readonly buffer ExcludeSites { int exclude_sites[]; };
 
@@ -142,14 +142,11 @@ void main() {
   if (i >= sample_count) {
     return;
   }
-  uint id = samples[i].x;
-  float band = uintBitsToFloat(samples[i].y);
+  float band = uintBitsToFloat(samples[i].w);
   int skip = exclude_sites[i];
   // With an excluded site only the nearest other site is asked for (DvdOutput).
   bool nearest_only = skip != kNoIndex;
-  uint dx = uint(dims_x);
-  uint dy = uint(dims_y);
-  ivec3 voxel = ivec3(int(id % dx), int((id / dx) % dy), int(id / (dx * dy)));
+  ivec3 voxel = ivec3(samples[i].xyz);
   vec3 centre = vec3(voxel) + 0.5;  // in cell units, exact
   vec3 q = centre * cell;
 

@@ -21,14 +21,11 @@ void main() {
   if (i >= sample_count) {
     return;
   }
-  uint id = samples[i].x;
-  float band = uintBitsToFloat(samples[i].y);
+  float band = uintBitsToFloat(samples[i].w);
   int f = sample_triangles[i];
   int object = triangle_info[f].x;
   ivec3 fv = triangle_vertices[f].xyz;
-  uint dx = uint(dims_x);
-  uint dy = uint(dims_y);
-  ivec3 voxel = ivec3(int(id % dx), int((id / dx) % dy), int(id / (dx * dy)));
+  ivec3 voxel = ivec3(samples[i].xyz);
   vec3 centre = vec3(voxel) + 0.5;  // in cell units, exact
   vec3 q = centre * cell;
 
