@@ -3,6 +3,7 @@
 #include "io/assimp_reader.hpp"
 #include "io/mesh_reader_detail.hpp"
 #include "io/obj_reader.hpp"
+#include "io/off_reader.hpp"
 #include "io/ply_reader.hpp"
 #include "io/read_util.hpp"
 
@@ -20,6 +21,11 @@ std::vector<MeshGroup> read_mesh_file(const fs::path& file) {
     groups.push_back(io_detail::read_ply(file));
     return groups;
   }
+  if (ext == ".off") {
+    std::vector<MeshGroup> groups;
+    groups.push_back(io_detail::read_off(file));
+    return groups;
+  }
   return io_detail::read_with_assimp(file);
 }
 
@@ -32,6 +38,7 @@ MeshGroup read_mesh_file_merged(const fs::path& file) {
     return std::move(one.front());
   }
   if (ext == ".ply") return read_ply(file);
+  if (ext == ".off") return read_off(file);
   std::vector<MeshGroup> groups = read_with_assimp(file);
   MeshGroup merged;
   merged.name = file.stem().string();

@@ -8,7 +8,7 @@
 
 namespace vproxq {
 
-/// One mesh of a file (an OBJ o/g group, a PLY file, an assimp mesh): vertices in file order
+/// One mesh of a file (an OBJ o/g group, a PLY or OFF file, an assimp mesh): vertices in file order
 /// (only those its faces use, when the file holds several groups) and faces re-indexed into them.
 struct MeshGroup {
   std::string name;
@@ -16,8 +16,8 @@ struct MeshGroup {
   std::vector<Face> faces;
 };
 
-/// Reads OBJ and PLY (ASCII and binary) with the project's own index-preserving, double
-/// precision readers; other formats through assimp (float precision, see README). Polygons
+/// Reads OBJ, PLY (ASCII and binary) and ASCII OFF with the project's own index-preserving,
+/// double precision readers; other formats through assimp (float precision, see README). Polygons
 /// are fan-triangulated. No welding, no reordering, no removal of degenerate faces.
 /// Throws InputError naming the file and the problem.
 std::vector<MeshGroup> read_mesh_file(const std::filesystem::path& file);

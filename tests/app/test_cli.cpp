@@ -413,5 +413,24 @@ TEST(CliVoronoi, WithoutEglAutoFallsBackToCpuAndGpuFails) {
   EXPECT_FALSE(fs::exists(dir / "gpu" / "results.json"));
 }
 
+// An .off file given as the scene goes through the project's own OFF reader: a good one
+// runs, one whose header declares more faces than it holds is an input error (exit 3, the
+// file named, no results written), not an abort.
+TEST(Cli, OffMeshFileAsTheScene) {
+  ScratchDir dir;
+  const auto good = dir.write("quad.off", "OFF\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n");
+  auto r = vproxq(quote(good) + " --queries distance -o " + quote(dir / "good") + " --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = read_json(dir / "good" / "results.json");
+  ASSERT_EQ(j.at("frames").size(), 1u);
+
+  const auto bad = dir.write("short.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n");
+  r = vproxq(quote(bad) + " --queries distance -o " + quote(dir / "bad") + " --quiet");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find(bad.string() + ": line 2: the header declares 2 faces"), std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(dir / "bad")) << "a failed run leaves no results behind";
+}
+
 }  // namespace
 }  // namespace vproxq

@@ -62,18 +62,6 @@ TEST(AssimpReader, StlKeepsOneVertexPerCornerWithoutWelding) {
   EXPECT_EQ(groups[0].positions[4], Vec3(1, 1, 0));
 }
 
-TEST(AssimpReader, OffIsIndexedAndPolygonsAreTriangulated) {
-  TempDir dir;
-  const auto file = dir.write("quad.off",
-                              "OFF\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n"
-                              "4 0 1 2 3\n3 0 1 4\n");
-  const auto groups = read_mesh_file(file);
-  ASSERT_EQ(groups.size(), 1u);
-  EXPECT_EQ(groups[0].name, "quad");
-  EXPECT_EQ(groups[0].positions.size(), 5u);
-  EXPECT_EQ(groups[0].faces.size(), 3u);
-}
-
 TEST(AssimpReaderErrors, MissingUnreadableAndUnknownFiles) {
   TempDir dir;
   const auto missing = dir.path() / "nothing.stl";
