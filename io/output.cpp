@@ -4,7 +4,9 @@
 #include "io/hdf5_writer.hpp"
 #include "io/json_writer.hpp"
 
+#include <atomic>
 #include <cerrno>
+#include <csignal>
 #include <chrono>
 #include <cstring>
 #include <optional>
@@ -13,6 +15,7 @@
 #include <vector>
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 namespace vproxq {
@@ -21,11 +24,73 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// ---- Cleanup on a fatal signal ---------------------------------------------------------
+//
+// A run stopped by SIGINT, SIGTERM or SIGHUP (Ctrl-C, timeout, a closed terminal) would
+// otherwise leave its temporary files and the directories it created. The paths live in
+// fixed slots that the handler reads with async-signal-safe calls only (unlink, rmdir,
+// signal, raise): files first, then directories, newest first; then the signal is raised
+// again with its default action, so the exit status still says which signal ended the run.
+constexpr int kCleanupSlots = 16;
+constexpr std::size_t kCleanupPathMax = 4096;
+struct CleanupSlot {
+  std::atomic<int> kind{0};  ///< 0 free, 1 file, 2 directory
+  char path[kCleanupPathMax];
+};
+CleanupSlot g_cleanup[kCleanupSlots];
+
+extern "C" void remove_partial_output(int sig) {
+  for (int kind : {1, 2})
+    for (int k = kCleanupSlots - 1; k >= 0; --k)
+      if (g_cleanup[k].kind.load() == kind) kind == 1 ? ::unlink(g_cleanup[k].path) : ::rmdir(g_cleanup[k].path);
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
+}
+
+/// Installs remove_partial_output() for the signals whose action is still the default (a
+/// signal the caller ignores stays ignored).
+void install_cleanup_handlers() {
+  static const bool installed = [] {
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+      struct sigaction old {};
+      if (::sigaction(sig, nullptr, &old) != 0 || old.sa_handler != SIG_DFL) continue;
+      struct sigaction act {};
+      act.sa_handler = remove_partial_output;
+      sigemptyset(&act.sa_mask);
+      ::sigaction(sig, &act, nullptr);
+    }
+    return true;
+  }();
+  (void)installed;
+}
+
+/// Registers `path` for removal on a fatal signal; returns its slot, or -1 when none is free
+/// or the path is too long (then only the normal cleanup applies).
+int register_cleanup(const fs::path& path, int kind) {
+  const std::string& s = path.native();
+  if (s.size() + 1 > kCleanupPathMax) return -1;
+  for (int k = 0; k < kCleanupSlots; ++k) {
+    if (g_cleanup[k].kind.load() != 0) continue;
+    std::memcpy(g_cleanup[k].path, s.c_str(), s.size() + 1);
+    g_cleanup[k].kind.store(kind);
+    return k;
+  }
+  return -1;
+}
+
+void unregister_cleanup(int& slot) {
+  if (slot >= 0) g_cleanup[slot].kind.store(0);
+  slot = -1;
+}
+
 /// A temporary file name that is removed on destruction unless it was moved into place.
 class TempPath {
  public:
-  explicit TempPath(fs::path path) : path_(std::move(path)) {}
+  /// `on_signal`: also remove the file when a fatal signal ends the run.
+  explicit TempPath(fs::path path, bool on_signal = true)
+      : path_(std::move(path)), slot_(on_signal ? register_cleanup(path_, 1) : -1) {}
   ~TempPath() {
+    unregister_cleanup(slot_);
     if (!path_.empty()) {
       std::error_code ignored;
       fs::remove(path_, ignored);
@@ -44,14 +109,19 @@ class TempPath {
       throw RuntimeError("cannot rename '" + path_.string() + "' to '" + target.string() +
                          "': " + ec.message());
     }
+    unregister_cleanup(slot_);
     path_.clear();
   }
 
   /// Forgets the path: nothing is removed on destruction.
-  void release() { path_.clear(); }
+  void release() {
+    unregister_cleanup(slot_);
+    path_.clear();
+  }
 
  private:
   fs::path path_;
+  int slot_ = -1;
 };
 
 fs::path temp_name(const fs::path& dir, const char* final_name) {
@@ -70,12 +140,21 @@ class CreatedDirs {
     // since stays, with what is in it.
     std::error_code ignored;
     for (auto it = dirs_.rbegin(); it != dirs_.rend(); ++it) fs::remove(*it, ignored);
+    keep();
   }
-  void add(fs::path dir) { dirs_.push_back(std::move(dir)); }
-  void keep() { dirs_.clear(); }
+  void add(fs::path dir) {
+    slots_.push_back(register_cleanup(dir, 2));
+    dirs_.push_back(std::move(dir));
+  }
+  void keep() {
+    for (int& slot : slots_) unregister_cleanup(slot);
+    slots_.clear();
+    dirs_.clear();
+  }
 
  private:
   std::vector<fs::path> dirs_;
+  std::vector<int> slots_;
 };
 
 /// Creates `out_dir` and its missing parents, recording the ones it created in `created`.
@@ -137,7 +216,7 @@ struct ResultWriter::Impl {
 };
 
 ResultWriter::ResultWriter(const fs::path& out_dir, const RunInfo& info)
-    : impl_(std::make_unique<Impl>(out_dir, info)) {}
+    : impl_((install_cleanup_handlers(), std::make_unique<Impl>(out_dir, info))) {}
 
 double ResultWriter::write_frame(const FrameResult& frame) {
   Impl& m = *impl_;
@@ -174,7 +253,9 @@ void ResultWriter::commit() {
   // results.json last: its presence means that results.h5 of the same run is in place too.
   // An earlier results.h5 is moved aside first and put back should results.json fail to
   // move into place, so that a failed commit leaves the earlier pair as it was.
-  TempPath previous_h5(temp_name(m.dir, "results.h5.previous"));
+  // (Not removed on a signal: a run stopped right here leaves the earlier file under this
+  // name rather than losing it.)
+  TempPath previous_h5(temp_name(m.dir, "results.h5.previous"), false);
   std::error_code ec;
   fs::rename(h5_final, previous_h5.path(), ec);
   const bool had_previous = !ec;

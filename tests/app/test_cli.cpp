@@ -157,6 +157,25 @@ TEST(Cli, InputErrorsNameTheFileAndLeaveNoOutput) {
 
 // A failed run removes the output directories it created (all of a nested -o path), and
 // leaves an existing directory and what was in it alone.
+// A run ended by SIGTERM or SIGHUP (a timeout, a closed terminal; SIGINT is handled the same
+// way, but a shell starts background jobs with it ignored) removes its temporary files and the
+// directories it created, then ends by that signal. The run is a slow one (a very fine grid on
+// one thread), signalled once its temporary files exist.
+TEST(Cli, ARunEndedByASignalLeavesNothingBehind) {
+  for (const auto& [sig, number] : {std::pair<const char*, int>{"TERM", 15}, {"HUP", 1}}) {
+    SCOPED_TRACE(sig);
+    ScratchDir dir;
+    const auto out = dir / "a" / "out";
+    const std::string run = std::string(VPROXQ_BINARY) + " " + quote(kSamples / "skirt-tiny" / "scene.json") +
+                            " --voronoi=cpu --grid 4096 --threads 1 --quiet -o " + quote(out);
+    const auto r = test::run_command(run + " & pid=$!; for i in $(seq 600); do ls " + quote(out) +
+                                     "/.results.json.tmp-* >/dev/null 2>&1 && break; sleep 0.05; done; kill -" +
+                                     sig + " $pid; wait $pid; echo \"status $?\"");
+    EXPECT_NE(r.output.find("status " + std::to_string(128 + number)), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "a")) << r.output;
+  }
+}
+
 TEST(Cli, FailedRunRemovesTheDirectoriesItCreated) {
   ScratchDir dir;
   const auto scene = dir.write("scene.json", R"({"frames": {"files": ["bad.obj"]}})");
