@@ -36,8 +36,16 @@ Json load_results(const fs::path& file) {
     throw InputError("cannot open results file '" + file.string() + "': " + std::strerror(errno));
   }
   Json doc;
+  // A results file is a few levels deep; comparing a far deeper document would recurse that
+  // deep.
+  constexpr int kMaxDepth = 64;
   try {
-    doc = Json::parse(in);
+    doc = Json::parse(in, [&](int depth, Json::parse_event_t, Json&) {
+      if (depth > kMaxDepth)
+        throw InputError("malformed results file '" + file.string() + "': nested more than " +
+                         std::to_string(kMaxDepth) + " levels deep");
+      return true;
+    });
   } catch (const nlohmann::json::exception& e) {
     throw InputError("malformed results file '" + file.string() + "': " + e.what());
   }

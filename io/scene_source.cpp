@@ -177,6 +177,10 @@ class SceneParser {
     if (!v.is_string() || v.get<std::string>().empty()) {
       fail(key, "must be a non-empty string, got " + shown(v));
     }
+    // A file name with a NUL would silently name the file before it.
+    if (v.get<std::string>().find('\0') != std::string::npos) {
+      fail(key, "must not contain a NUL character (\\u0000), got " + shown(v));
+    }
     return v.get<std::string>();
   }
 
@@ -309,8 +313,15 @@ void parse_scene_json(SceneImpl& s) {
   const std::string text = io_detail::read_whole_file(s.path);
   const std::string where = s.path.string();
   json root;
+  // A scene is a few levels deep; far deeper nesting is no scene, and printing or walking it
+  // would recurse that deep.
+  constexpr int kMaxDepth = 64;
   try {
-    root = json::parse(text);
+    root = json::parse(text, [&](int depth, json::parse_event_t, json&) {
+      if (depth > kMaxDepth)
+        throw InputError(where + ": invalid JSON: nested more than " + std::to_string(kMaxDepth) + " levels deep");
+      return true;
+    });
   } catch (const json::parse_error& e) {
     throw InputError(where + ": invalid JSON: " + e.what());
   }

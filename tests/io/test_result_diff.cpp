@@ -240,6 +240,15 @@ TEST_F(DiffTest, MalformedFileThrowsInputErrorNamingIt) {
   EXPECT_THROW(diff_result_files(bad, good, {}), InputError);
   const fs::path not_results = save_text("array.json", "[1, 2, 3]");
   EXPECT_THROW(diff_result_files(good, not_results, {}), InputError);
+  // Nesting far beyond a results file's few levels is refused while parsing (comparing it
+  // recursed that deep and overflowed the stack).
+  const fs::path deep = save_text("deep.json", "{\"frames\": " + std::string(100000, '[') + std::string(100000, ']') + "}");
+  try {
+    diff_result_files(deep, deep, {});
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("nested more than"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(DiffTest, MissingFileThrowsInputErrorNamingIt) {

@@ -267,6 +267,17 @@ TEST_F(SceneSourceTest, EmptyAndBadFramesNameTheirFile) {
 
 // ---- scene.json errors: the message names the scene file, the key and why ----
 
+// Nesting far beyond a scene's few levels is refused while parsing (printing it in the
+// message about the wrong type recursed that deep and overflowed the stack).
+TEST_F(SceneSourceTest, DeeplyNestedJsonIsAnInputError) {
+  const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+  for (const std::string& text : {deep, "{\"name\": " + deep + "}"}) {
+    const auto path = scene(text);
+    const std::string message = test::input_error_message([&] { SceneSource::open(path); });
+    EXPECT_EQ(message.rfind(path.string() + ": invalid JSON: nested more than", 0), 0u) << message;
+  }
+}
+
 struct BadScene {
   const char* json;
   std::vector<std::string> phrases;
@@ -327,6 +338,8 @@ TEST_F(SceneSourceTest, EveryBadKeyIsReported) {
       {R"({"frames": {"files": []}})", {"\"frames.files\" must be a non-empty array"}},
       {R"({"frames": {"files": "a_0.obj"}})", {"\"frames.files\" must be a non-empty array"}},
       {R"({"frames": {"files": [3]}})", {"\"frames.files[0]\" must be a non-empty string, got 3"}},
+      {R"({"frames": {"files": ["a_0.obj\u0000x"]}})",
+       {"\"frames.files[0]\" must not contain a NUL character"}},
       {R"({"frames": {"files": ["a_0.obj", "b.obj"]}})",
        {"\"frames.files[1]\" frame 1: file not found: ", "b.obj"}},
       {R"({"frames": {"files": ["a_0.obj"]}, "objects": "mesh"})",
