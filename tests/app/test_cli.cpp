@@ -240,6 +240,20 @@ TEST(Cli, OutOfMemoryIsARuntimeErrorWithoutOutput) {
   EXPECT_FALSE(fs::exists(out / "results.h5"));
 }
 
+// A write that fails (here: a file-size limit, as a full disk would) is a runtime error with a
+// one-line message and no output; the HDF5 library's exit handler used to crash after it.
+TEST(Cli, AFailedWriteIsARuntimeErrorWithoutOutput) {
+  ScratchDir dir;
+  const auto out = dir / "out";
+  const auto r = test::run_command("ulimit -f 8; trap '' XFSZ; " + std::string(VPROXQ_BINARY) + " " +
+                                   quote(kSamples / "blobs-small" / "scene.json") +
+                                   " --queries distance,ccd,pd --quiet -o " + quote(out));
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  EXPECT_NE(r.output.find("File too large"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find('\n'), r.output.size() - 1) << "one line: " << r.output;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST(Cli, FailureKeepsEarlierResultsIntact) {
   ScratchDir dir;
   const std::string tri = "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no b\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf 4 5 6\n";
