@@ -198,7 +198,8 @@ int cli_main(int argc, char** argv) {
                  "distance). Valid: " + query_names_list())
       ->delimiter(',');
   app.add_option("-o,--output", config.output_dir,
-                 "write OUT/results.json and OUT/results.h5 (default: print a summary)");
+                 "write OUT/results.json and OUT/results.h5 (default: print a summary)")
+      ->check([](const std::string& dir) { return dir.empty() ? std::string("the output directory must not be empty") : std::string(); });
   app.add_option("--frames", frames, "frame range A:B (0-based, B exclusive; A: or :B or A)");
   app.add_option("--voronoi", config.voronoi,
                  "Stage II (discrete Voronoi culling) backend: gpu (OpenGL compute in a headless "

@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <iterator>
 #include <mutex>
+#include <set>
 #include <stdexcept>
 #include <string_view>
 
@@ -240,8 +241,13 @@ class SceneParser {
 
   void require_file(const fs::path& file, const std::string& key, std::size_t position) const {
     std::error_code ec;
-    if (!fs::is_regular_file(file, ec)) {
-      fail(key, "frame " + std::to_string(position) + ": file not found: " + file.string());
+    const fs::file_status st = fs::status(file, ec);
+    if (ec && ec != std::errc::no_such_file_or_directory) {
+      fail(key, "frame " + std::to_string(position) + ": cannot access " + file.string() + " (" + ec.message() + ")");
+    }
+    if (!fs::exists(st)) fail(key, "frame " + std::to_string(position) + ": file not found: " + file.string());
+    if (!fs::is_regular_file(st)) {
+      fail(key, "frame " + std::to_string(position) + ": not a regular file: " + file.string());
     }
   }
 
@@ -316,10 +322,16 @@ void parse_scene_json(SceneImpl& s) {
   // A scene is a few levels deep; far deeper nesting is no scene, and printing or walking it
   // would recurse that deep.
   constexpr int kMaxDepth = 64;
+  // Keys seen in each object being parsed: a key given twice would silently keep the last.
+  std::vector<std::set<std::string>> keys;
   try {
-    root = json::parse(text, [&](int depth, json::parse_event_t, json&) {
+    root = json::parse(text, [&](int depth, json::parse_event_t event, json& parsed) {
       if (depth > kMaxDepth)
         throw InputError(where + ": invalid JSON: nested more than " + std::to_string(kMaxDepth) + " levels deep");
+      if (event == json::parse_event_t::object_start) keys.emplace_back();
+      if (event == json::parse_event_t::object_end) keys.pop_back();
+      if (event == json::parse_event_t::key && !keys.back().insert(parsed.get<std::string>()).second)
+        throw InputError(where + ": invalid JSON: the key " + parsed.dump() + " appears twice in one object");
       return true;
     });
   } catch (const json::parse_error& e) {

@@ -92,6 +92,9 @@ TEST(Cli, UsageErrors) {
   }
   r = vproxq(scene + " --grid=0");
   EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = vproxq(scene + " -o ''");  // not "no output": a usage error
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--output"), std::string::npos) << r.output;
   r = vproxq(scene + " --grid=4097");  // past kMaxGridResolution
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("--grid"), std::string::npos) << r.output;
