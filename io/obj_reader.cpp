@@ -22,19 +22,6 @@ constexpr std::array<std::string_view, 31> kIgnoredStatements = {
     "trim",     "hole",     "scrv", "sp",     "end",    "con",        "mg",       "bevel",
     "c_interp", "d_interp", "lod",  "maplib", "usemap", "shadow_obj", "trace_obj"};
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
-
-/// Splits off the next whitespace-separated token of `rest` (empty when none is left).
-std::string_view next_token(std::string_view& rest) {
-  std::size_t b = 0;
-  while (b < rest.size() && is_space(rest[b])) ++b;
-  std::size_t e = b;
-  while (e < rest.size() && !is_space(rest[e])) ++e;
-  const std::string_view tok = rest.substr(b, e - b);
-  rest.remove_prefix(e);
-  return tok;
-}
-
 std::string_view trim(std::string_view s) {
   while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
   while (!s.empty() && is_space(s.back())) s.remove_suffix(1);

@@ -13,19 +13,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
-
-/// Splits off the next whitespace-separated token of `rest` (empty when none is left).
-std::string_view next_token(std::string_view& rest) {
-  std::size_t b = 0;
-  while (b < rest.size() && is_space(rest[b])) ++b;
-  std::size_t e = b;
-  while (e < rest.size() && !is_space(rest[e])) ++e;
-  const std::string_view tok = rest.substr(b, e - b);
-  rest.remove_prefix(e);
-  return tok;
-}
-
 std::vector<std::string_view> split_words(std::string_view line) {
   std::vector<std::string_view> words;
   for (std::string_view tok = next_token(line); !tok.empty(); tok = next_token(line)) {

@@ -81,7 +81,7 @@ struct Header {
   std::size_t data_offset = 0;  ///< first byte after the end_header line
 };
 
-bool is_space(char c) {
+bool is_space_or_newline(char c) {
   return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v';
 }
 
@@ -89,9 +89,9 @@ std::vector<std::string_view> split_words(std::string_view line) {
   std::vector<std::string_view> words;
   std::size_t i = 0;
   while (i < line.size()) {
-    while (i < line.size() && is_space(line[i])) ++i;
+    while (i < line.size() && is_space_or_newline(line[i])) ++i;
     std::size_t j = i;
-    while (j < line.size() && !is_space(line[j])) ++j;
+    while (j < line.size() && !is_space_or_newline(line[j])) ++j;
     if (j > i) words.push_back(line.substr(i, j - i));
     i = j;
   }
@@ -296,7 +296,7 @@ class AsciiCursor {
 
  private:
   std::string_view token() {
-    while (p_ < end_ && is_space(*p_)) {
+    while (p_ < end_ && is_space_or_newline(*p_)) {
       if (*p_ == '\n') ++line_;
       ++p_;
     }
@@ -304,7 +304,7 @@ class AsciiCursor {
       throw_input_error(*where_.file, "unexpected end of file inside " + where_.record_text());
     }
     const char* b = p_;
-    while (p_ < end_ && !is_space(*p_)) ++p_;
+    while (p_ < end_ && !is_space_or_newline(*p_)) ++p_;
     return std::string_view(b, static_cast<std::size_t>(p_ - b));
   }
   [[noreturn]] void malformed(std::string_view tok, const char* expected) const {

@@ -10,6 +10,20 @@
 
 namespace vproxq::io_detail {
 
+/// Whitespace within a line of a text mesh file: space, tab, CR, form feed, vertical tab.
+inline bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+
+/// Splits off the next is_space()-separated token of `rest` (empty when none is left).
+inline std::string_view next_token(std::string_view& rest) {
+  std::size_t b = 0;
+  while (b < rest.size() && is_space(rest[b])) ++b;
+  std::size_t e = b;
+  while (e < rest.size() && !is_space(rest[e])) ++e;
+  const std::string_view tok = rest.substr(b, e - b);
+  rest.remove_prefix(e);
+  return tok;
+}
+
 /// "<file>: <what>" as an InputError.
 [[noreturn]] void throw_input_error(const std::filesystem::path& file, const std::string& what);
 
