@@ -252,7 +252,8 @@ void ResultWriter::commit() {
   }
   // results.json last: its presence means that results.h5 of the same run is in place too.
   // An earlier results.h5 is moved aside first and put back should results.json fail to
-  // move into place, so that a failed commit leaves the earlier pair as it was.
+  // move into place (or results.h5 itself fails to), so that a failed commit leaves the
+  // earlier pair as it was.
   // (Not removed on a signal: a run stopped right here leaves the earlier file under this
   // name rather than losing it.)
   TempPath previous_h5(temp_name(m.dir, "results.h5.previous"), false);
@@ -260,8 +261,8 @@ void ResultWriter::commit() {
   fs::rename(h5_final, previous_h5.path(), ec);
   const bool had_previous = !ec;
   if (!had_previous) previous_h5.release();  // nothing there to remove
-  m.h5_temp.move_to(h5_final);
   try {
+    m.h5_temp.move_to(h5_final);
     m.json_temp.move_to(json_final);
   } catch (const RuntimeError& e) {
     std::string kept;
