@@ -112,6 +112,20 @@ CcdVoxelOutput GlCcdVoxelBackend::voxelize(const CcdVoxelInput& in) {
       if (in.cooccupancy) b.foreign->download(out.foreign.data() + b.first, 4 * b.count);
     }
   });
+  // A record whose box the shader did not finish (a driver's loop cap, see ccd_voxels.comp):
+  // the keys and the table are incomplete, so the whole input is done on the CPU, whose
+  // integer work gives the same output.
+  const bool incomplete =
+      std::any_of(out.counts.begin(), out.counts.end(), [](std::uint32_t c) { return c == 0xFFFFFFFFu; }) ||
+      std::any_of(out.foreign.begin(), out.foreign.end(), [](std::uint32_t f) { return f == 2; });
+  last_fell_back_ = incomplete;
+  if (incomplete) {
+    CcdVoxelOutput cpu = make_cpu_ccd_voxel_backend(0)->voxelize(in);
+    cpu.upload_ms += out.upload_ms;
+    cpu.compute_ms += out.compute_ms;
+    cpu.readback_ms += out.readback_ms;
+    return cpu;
+  }
   return out;
 }
 

@@ -28,12 +28,16 @@ class GlCcdVoxelBackend final : public CcdVoxelBackend {
   /// Throws GlError when a record's room alone exceeds the buffer limit or a GL call fails.
   CcdVoxelOutput voxelize(const CcdVoxelInput& in) override;
   std::size_t last_batch_count() const { return last_batch_count_; }
+  /// Whether the last voxelize() was redone on the CPU because the shader could not finish a
+  /// record's box (a driver's loop cap: ccd_voxels.comp).
+  bool last_fell_back() const { return last_fell_back_; }
 
  private:
   const Context& context_;
   GlCcdVoxelOptions options_;
   ComputeProgram program_;
   std::size_t last_batch_count_ = 0;
+  bool last_fell_back_ = false;
 };
 
 }  // namespace vproxq::gl

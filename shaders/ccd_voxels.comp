@@ -8,10 +8,15 @@
 //   binding 1  room         per record: where its keys start in `keys` (this batch's offset)
 //   binding 2  objects      per record: the object id of its triangle
 //   binding 3  keys         out (pass 0): the record's keys, ascending, from room[r]
-//   binding 4  counts       out (pass 0): the number of keys of each record
+//   binding 4  counts       out (pass 0): the number of keys of each record, or kIncomplete
+//                           when the loops did not visit the whole box (see below)
 //   binding 5  table        per key: 0 unmarked, object + 1 marked by that object only,
 //                           0xFFFFFFFF by two or more (zeroed by the host before pass 0)
-//   binding 6  foreign      out (pass 1): 1 when one of the record's keys is in two objects
+//   binding 6  foreign      out (pass 1): 1 when one of the record's keys is in two objects,
+//                           2 when the loops did not visit the whole box
+// Some drivers cap the loop iterations of one invocation (Mesa's llvmpipe stops every loop
+// after 65535 iterations in all, silently): each invocation counts the voxels it visited and
+// reports a box it did not finish, so that the host can redo the work another way.
 // Uniforms: dims_x, dims_y (grid size per slot), record_count (this batch), pass (0: mark, 1: foreign),
 // cooccupancy (0: no table, pass 0 only lists keys).
 // Voxel (x, y, z) is kept iff below[a] < axis[a] . (x, y, z) < above[a] for a = 0, 1, 2: all
@@ -37,6 +42,7 @@ uniform uint pass;
 uniform uint cooccupancy;
 
 const uint kShared = 0xFFFFFFFFu;
+const uint kIncomplete = 0xFFFFFFFFu;
 
 void main() {
   uint r = gl_GlobalInvocationID.x;
@@ -52,10 +58,12 @@ void main() {
   uint key_base = uint(records[base + 21]);
   uint me = uint(objects[r]) + 1u;
   uint n = 0u;
+  uint visited = 0u;
   bool shared_key = false;
   for (int z = lo.z; z <= hi.z; ++z) {
     for (int y = lo.y; y <= hi.y; ++y) {
       for (int x = lo.x; x <= hi.x; ++x) {
+        ++visited;
         ivec3 d = ivec3(axis[0].x * x + axis[0].y * y + axis[0].z * z,
                         axis[1].x * x + axis[1].y * y + axis[1].z * z,
                         axis[2].x * x + axis[2].y * y + axis[2].z * z);
@@ -75,8 +83,10 @@ void main() {
       }
     }
   }
+  ivec3 size = max(hi - lo + 1, ivec3(0));
+  bool complete = visited == uint(size.x) * uint(size.y) * uint(size.z);
   if (pass == 0u)
-    counts[r] = n;
+    counts[r] = complete ? n : kIncomplete;
   else
-    foreign[r] = shared_key ? 1u : 0u;
+    foreign[r] = complete ? (shared_key ? 1u : 0u) : 2u;
 }

@@ -3,6 +3,8 @@
 // keys, counts, co-occupancy flags, and the culling decisions and results of the pipeline.
 #include <gtest/gtest.h>
 
+#include <iostream>
+
 #include "core/query/ccd.hpp"
 #include "core/voronoi/ccd_stage2.hpp"
 #include "gl/ccd_voxel_backend.hpp"
@@ -31,6 +33,43 @@ TEST(CcdVoxelsGl, RandomRecordsEqualTheReferenceAndTheCpu) {
     }
     EXPECT_GT(small_batches.last_batch_count(), 1u);
   }
+}
+
+// Records whose boxes hold more voxels than one invocation may loop over on some drivers
+// (llvmpipe stops every loop of an invocation after 65535 iterations in all): the output still
+// equals the reference, the shader reporting the boxes it could not finish and the backend
+// redoing the input on the CPU. A fine grid on a scene of a few large triangles made such
+// records and lost contacts before.
+TEST(CcdVoxelsGl, BoxesBeyondADriversLoopCapEqualTheReference) {
+  VPROXQ_GL_CONTEXT_OR_FAIL(context);
+  GlCcdVoxelBackend gpu(context);
+  const auto cpu = make_cpu_ccd_voxel_backend(2);
+  CcdVoxelInput in = test::random_ccd_voxel_input(7, {48, 48, 48}, 2, 40);
+  // Two records spanning 48 x 48 x 40 = 92,160 voxels each, of two objects, cut by one plane.
+  for (int r = 0; r < 2; ++r) {
+    CcdVoxelRecord& rec = in.records[static_cast<size_t>(r)];
+    rec.lo = {0, 0, r * 8};
+    rec.hi = {47, 47, 39 + r * 8};
+    rec.axis = {{{1, 1, 1}, {0, 0, 0}, {0, 0, 0}}};
+    rec.below = {20, -1, -1};
+    rec.above = {200, 1, 1};
+    in.record_object[static_cast<size_t>(r)] = r;
+  }
+  in.out_offsets.assign(in.records.size() + 1, 0);
+  for (size_t r = 0; r < in.records.size(); ++r) {
+    const auto& rec = in.records[r];
+    std::uint64_t volume = 1;
+    for (int k = 0; k < 3; ++k) volume *= static_cast<std::uint64_t>(rec.hi[k] - rec.lo[k] + 1);
+    in.out_offsets[r + 1] = in.out_offsets[r] + volume;
+  }
+  const CcdVoxelOutput g = gpu.voxelize(in);
+  test::expect_ccd_output_matches_reference(in, g);
+  const CcdVoxelOutput c = cpu->voxelize(in);
+  EXPECT_EQ(g.counts, c.counts);
+  EXPECT_EQ(g.foreign, c.foreign);
+  EXPECT_GT(c.counts[0], 65535u);
+  std::cout << "GL CCD voxels on " << context.info().gl_renderer
+            << (gpu.last_fell_back() ? ": redone on the CPU (loop cap)\n" : ": finished on the GPU\n");
 }
 
 TEST(CcdVoxelsGl, PipelineCullingEqualsTheCpuBackend) {
