@@ -252,12 +252,14 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
     if (!(cell > 0) || !std::isfinite(cell)) cell = longest / 32;
     // Budget: a few large triangles (a static floor or funnel next to a fine cloth) would
     // otherwise cover millions of voxels each. Estimate the voxels the records will visit
-    // (a cube of a triangle's per-slot size, plus a cell either side) and coarsen the cell
-    // until they average at most kRoomPerRecord.
+    // (a cube of a triangle's per-slot size widened by the culling margin on both sides, plus
+    // a cell either side) and coarsen the cell until they average at most kRoomPerRecord.
+    // (The margin grows with the coordinates' magnitude: far from the origin it can exceed
+    // the triangles themselves.)
     cell = std::max(cell, longest / (kMaxDim - 2));
     for (int attempt = 0; attempt < 64; ++attempt) {
       double room = 0;
-      for (double d : size) room += std::pow(std::min(d / cell, double{kMaxDim}) + 2, 3);
+      for (double d : size) room += std::pow(std::min((d + 2 * sweep.margin) / cell, double{kMaxDim}) + 2, 3);
       if (room <= kRoomPerRecord * static_cast<double>(size.size())) break;
       cell *= 1.25;
     }

@@ -9,6 +9,7 @@
 #include "core/query/ccd.hpp"
 #include "core/voronoi/ccd_stage2.hpp"
 #include "support/ccd_voxels.hpp"
+#include "support/expect_same.hpp"
 #include "support/random_scene.hpp"
 
 #include <algorithm>
@@ -181,6 +182,28 @@ TEST(CcdStage2, RandomStepsEqualBruteForceWithEverySlotCount) {
       }
     }
   }
+}
+
+// Far from the origin the culling margin (it grows with the coordinates' magnitude) can
+// exceed the triangles themselves; the default cell then grows with it. Sizing the cell by
+// the triangles alone made every record's box millions of voxels at 2^42 (out of memory);
+// at 2^33 it made them thousands. Here each record marks a bounded number of voxels and the
+// results equal the brute force.
+TEST(CcdStage2, DefaultCellAllowsForAMarginLargerThanTheTriangles) {
+  Frame from = test::make_random_frame(3, 3, 2.0, 1);
+  for (Object& o : from.objects)
+    for (Vec3& p : o.positions) p += Vec3(std::ldexp(1.0, 33), 0, 0);
+  from.index = 0;
+  const Frame to = moved(from, 5, 0.6, 0.1);
+  const CcdSweep sweep = CcdSweep::compute(from, to, 2);
+  std::size_t triangles = 0;
+  for (const Object& o : from.objects) triangles += static_cast<std::size_t>(o.num_triangles());
+  ASSERT_GT(sweep.margin, 0.5) << sweep.margin;  // larger than the scene's triangles (edges ~0.3-0.5)
+  const CcdVoxelCulling voxels(from, to, sweep, 0, 2);
+  const std::size_t records = triangles * static_cast<std::size_t>(voxels.slots());
+  EXPECT_LE(voxels.marked_voxels(), 200 * records) << voxels.marked_voxels() << " marks, " << records << " records";
+  const CcdStepResult ref = continuous_collisions_brute_force(from, to);
+  test::expect_same_ccd(continuous_collisions(from, to, sweep, CcdOptions{2, &voxels}), ref);
 }
 
 }  // namespace
