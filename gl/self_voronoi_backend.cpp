@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/voronoi/bins.hpp"
+#include "core/parallel.hpp"
 #include "gl/dvd_gather_common.hpp"
 #include "gl/shader_source.hpp"
 
@@ -83,15 +84,37 @@ SelfDvdOutput GlSelfVoronoiBackend::compute(const SelfDvdInput& self) {
     batch.sample_triangles.bind(6);
   }, last_dispatch_count_);
 
+  std::vector<std::size_t> redo;
   out.readback_ms = finish_timed_ms(context_, [&] {
     for (const Batch& batch : batches) {
       const std::vector<std::int32_t> results = batch.results.download_vector<std::int32_t>(4 * batch.count);
       for (std::size_t k = 0; k < batch.count; ++k) {
         std::memcpy(&out.dist[batch.first + k], &results[4 * k], sizeof(float));
         last_nearest_[batch.first + k] = results[4 * k + 1];
+        if (results[4 * k + 2] != 0) redo.push_back(batch.first + k);
       }
     }
   });
+  // Samples the shader could not finish (a driver's loop cap: dvd2_gather.comp) are computed
+  // by the CPU twin, whose error bound is below this backend's; their last_nearest() is -1.
+  last_redone_ = redo.size();
+  if (!redo.empty()) {
+    SelfDvdInput part = self;
+    part.dvd.voxels.clear();
+    part.dvd.band.clear();
+    part.dvd.exclude_site.clear();
+    part.sample_triangle.clear();
+    for (const std::size_t k : redo) {
+      part.dvd.voxels.push_back(in.voxels[k]);
+      part.dvd.band.push_back(in.band[k]);
+      part.sample_triangle.push_back(self.sample_triangle[k]);
+    }
+    const SelfDvdOutput cpu = make_cpu_self_voronoi_backend(resolve_threads(0))->compute(part);
+    for (std::size_t j = 0; j < redo.size(); ++j) {
+      out.dist[redo[j]] = cpu.dist[j];
+      last_nearest_[redo[j]] = kNoIndex;
+    }
+  }
   return out;
 }
 

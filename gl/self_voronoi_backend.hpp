@@ -33,6 +33,9 @@ class GlSelfVoronoiBackend final : public SelfVoronoiBackend {
   /// band), for tests.
   const std::vector<std::int32_t>& last_nearest() const { return last_nearest_; }
   std::size_t last_dispatch_count() const { return last_dispatch_count_; }
+  /// Samples of the last compute() that the shader could not finish (a driver's loop cap:
+  /// shaders/dvd2_gather.comp) and the CPU twin computed instead.
+  std::size_t last_redone() const { return last_redone_; }
 
  private:
   const Context& context_;
@@ -40,6 +43,7 @@ class GlSelfVoronoiBackend final : public SelfVoronoiBackend {
   ComputeProgram program_;
   std::vector<std::int32_t> last_nearest_;
   std::size_t last_dispatch_count_ = 0;
+  std::size_t last_redone_ = 0;
 };
 
 }  // namespace vproxq::gl

@@ -1,5 +1,6 @@
 #include "gl/voronoi_backend.hpp"
 
+#include "core/parallel.hpp"
 #include "gl/dvd_gather_common.hpp"
 
 #include <algorithm>
@@ -134,6 +135,9 @@ double GlVoronoiBackend::distance_error_bound(double extent) const {
   return float32_error_bound(extent);
 }
 
+/// site1 of a sample whose loops the shader did not finish (dvd2_gather.comp).
+constexpr std::int32_t kShaderIncomplete = -2;
+
 DvdOutput GlVoronoiBackend::compute(const DvdInput& in) {
   validate_dvd_input(in);
   check_dvd_addressable(in, "GlVoronoiBackend");
@@ -186,6 +190,30 @@ DvdOutput GlVoronoiBackend::compute(const DvdInput& in) {
       }
     }
   });
+  // Samples the shader could not finish (a driver's loop cap: dvd2_gather.comp) are computed
+  // by the CPU twin, whose error bound is below this backend's.
+  std::vector<std::size_t> redo;
+  for (std::size_t k = 0; k < voxel_count; ++k)
+    if (out.site1[k] == kShaderIncomplete) redo.push_back(k);
+  last_redone_ = redo.size();
+  if (!redo.empty()) {
+    DvdInput part = in;
+    part.voxels.clear();
+    part.band.clear();
+    part.exclude_site.clear();
+    for (const std::size_t k : redo) {
+      part.voxels.push_back(in.voxels[k]);
+      part.band.push_back(in.band[k]);
+      part.exclude_site.push_back(in.exclude_site.empty() ? kNoIndex : in.exclude_site[k]);
+    }
+    const DvdOutput cpu = make_cpu_voronoi_backend(resolve_threads(0))->compute(part);
+    for (std::size_t j = 0; j < redo.size(); ++j) {
+      out.site1[redo[j]] = cpu.site1[j];
+      out.site2[redo[j]] = cpu.site2[j];
+      out.dist1[redo[j]] = cpu.dist1[j];
+      out.dist2[redo[j]] = cpu.dist2[j];
+    }
+  }
   return out;
 }
 

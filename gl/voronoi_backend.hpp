@@ -53,6 +53,9 @@ class GlVoronoiBackend final : public DiscreteVoronoiBackend {
   double compile_ms() const { return compile_ms_; }
   /// Number of glDispatchCompute calls of the last compute().
   std::size_t last_dispatch_count() const { return last_dispatch_count_; }
+  /// Samples of the last compute() that the shader could not finish (a driver's loop cap:
+  /// shaders/dvd2_gather.comp) and the CPU twin computed instead.
+  std::size_t last_redone() const { return last_redone_; }
 
  private:
   const Context& context_;
@@ -60,6 +63,7 @@ class GlVoronoiBackend final : public DiscreteVoronoiBackend {
   double compile_ms_ = 0;  // before program_: set while program_ is initialized
   ComputeProgram program_;
   std::size_t last_dispatch_count_ = 0;
+  std::size_t last_redone_ = 0;
 };
 
 }  // namespace vproxq::gl

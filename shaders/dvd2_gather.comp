@@ -12,7 +12,11 @@
 //   binding 4  samples        uvec4 per sample voxel of this batch: its voxel coordinates
 //                             (x, y, z) and its band (float bits)
 //   binding 5  results        ivec4 per sample voxel of this batch: site1, site2, and the float
-//                             bits of dist1, dist2 (site -1 and dist = band when none)
+//                             bits of dist1, dist2 (site -1 and dist = band when none); site1
+//                             kIncomplete (-2) when the loops did not visit every bin entry:
+//                             some drivers cap an invocation's loop iterations (Mesa's llvmpipe
+//                             stops every loop after 65535 in all, silently), and the host then
+//                             computes that sample another way
 //   binding 8  exclude_sites  int per sample voxel of this batch: a site whose triangles are
 //                             ignored there (DvdInput::exclude_site), or -1
 // Uniforms: sample_count (this batch), cell, dims_x/y/z (grid), bin_size, bin_dims_x/y,
@@ -48,6 +52,7 @@ uniform float prefilter_margin;
 
 const int kNoSite = 0x7FFFFFFF;  // larger than every site: "smaller id first" needs no case
 const int kNoIndex = -1;
+const int kIncomplete = -2;
 // Squared lengths at or below 2^-100 count as zero: the division they would feed is then
 // inside GLSL's accuracy range [2^-126, 2^126], and treating such an edge or height as zero
 // moves the result by at most 2^-50 (the absolute term of the error bound).
@@ -164,13 +169,21 @@ void main() {
   int s2 = kNoSite;
   float cutoff = band + prefilter_margin;
   float cutoff_squared = cutoff * cutoff;
+  // What the loops must visit, and what they did (see kIncomplete).
+  uint bins_planned = uint(bin_hi.x - bin_lo.x + 1) * uint(bin_hi.y - bin_lo.y + 1) * uint(bin_hi.z - bin_lo.z + 1);
+  uint bins_visited = 0u;
+  int entries_planned = 0;
+  int entries_visited = 0;
   for (int bz = bin_lo.z; bz <= bin_hi.z; ++bz) {
     for (int by = bin_lo.y; by <= bin_hi.y; ++by) {
       for (int bx = bin_lo.x; bx <= bin_hi.x; ++bx) {
         ivec3 here = ivec3(bx, by, bz);
         int b = bx + bin_dims_x * (by + bin_dims_y * bz);
         int end = bin_offsets[b + 1];
+        ++bins_visited;
+        entries_planned += end - bin_offsets[b];
         for (int j = bin_offsets[b]; j < end; ++j) {
+          ++entries_visited;
           int t = bin_triangles[j];
           ivec4 info = triangle_info[t];
           // Visit a triangle once: in the first visited bin of its own range.
@@ -213,6 +226,7 @@ void main() {
   float dist2 = sqrt(d2);
   bool has1 = s1 != kNoSite && dist1 < band;
   bool has2 = !nearest_only && s2 != kNoSite && dist2 < band;
-  results[i] = ivec4(has1 ? s1 : kNoIndex, has2 ? s2 : kNoIndex,
+  bool complete = bins_visited == bins_planned && entries_visited == entries_planned;
+  results[i] = ivec4(complete ? (has1 ? s1 : kNoIndex) : kIncomplete, has2 ? s2 : kNoIndex,
                      floatBitsToInt(has1 ? dist1 : band), floatBitsToInt(has2 ? dist2 : band));
 }

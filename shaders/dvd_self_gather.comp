@@ -8,7 +8,9 @@
 // renamed by a #define), so it shares that shader's storage buffers 0-4, uniforms, distance
 // function, bin search and error bound; only the parts below are new:
 //   binding 5  results           ivec4 per sample of this batch: float bits of the distance
-//                                (band when none below it), nearest triangle (-1 when none), 0, 0
+//                                (band when none below it), nearest triangle (-1 when none),
+//                                1 when the loops did not finish (a driver's loop cap, as in
+//                                dvd2_gather.comp) else 0, and 0
 //   binding 6  sample_triangles  int per sample of this batch: the sample's triangle f
 //   binding 7  triangle_vertices ivec4 per triangle: its 3 object-local vertex ids, 0
 // triangle_info.x (binding 1) is the triangle's object.
@@ -40,13 +42,21 @@ void main() {
   int nearest = kNoIndex;
   float cutoff = band + prefilter_margin;
   float cutoff_squared = cutoff * cutoff;
+  // What the loops must visit, and what they did (kIncomplete: see dvd2_gather.comp).
+  uint bins_planned = uint(bin_hi.x - bin_lo.x + 1) * uint(bin_hi.y - bin_lo.y + 1) * uint(bin_hi.z - bin_lo.z + 1);
+  uint bins_visited = 0u;
+  int entries_planned = 0;
+  int entries_visited = 0;
   for (int bz = bin_lo.z; bz <= bin_hi.z; ++bz) {
     for (int by = bin_lo.y; by <= bin_hi.y; ++by) {
       for (int bx = bin_lo.x; bx <= bin_hi.x; ++bx) {
         ivec3 here = ivec3(bx, by, bz);
         int b = bx + bin_dims_x * (by + bin_dims_y * bz);
         int end = bin_offsets[b + 1];
+        ++bins_visited;
+        entries_planned += end - bin_offsets[b];
         for (int j = bin_offsets[b]; j < end; ++j) {
+          ++entries_visited;
           int t = bin_triangles[j];
           ivec4 info = triangle_info[t];
           if (info.x != object || max(info.yzw, bin_lo) != here) {
@@ -76,5 +86,6 @@ void main() {
   }
   float dist = sqrt(best);
   bool has = nearest != kNoIndex && dist < band;
-  results[i] = ivec4(floatBitsToInt(has ? dist : band), has ? nearest : kNoIndex, 0, 0);
+  bool complete = bins_visited == bins_planned && entries_visited == entries_planned;
+  results[i] = ivec4(floatBitsToInt(has ? dist : band), has ? nearest : kNoIndex, complete ? 0 : 1, 0);
 }

@@ -3,6 +3,9 @@
 // intra-object query with every backend (off, cpu, gpu) equal to the brute force, per triangle
 // and bitwise, on generated meshes and on the test meshes (bunny, height field, thick cloth).
 #include <gtest/gtest.h>
+#include "core/voronoi/bins.hpp"
+#include <random>
+#include <iostream>
 
 #include <algorithm>
 #include <cmath>
@@ -103,6 +106,42 @@ void check_all_backends(const Context& context, const Frame& frame, const std::s
       }
     expect_same_intra(intra_object_distance(frame, boxes, ring2, {2, &gb}), ref, at + ", gpu");
   }
+}
+
+// Samples whose bins hold more triangles than one invocation may loop over on some drivers
+// (llvmpipe stops an invocation's loops after 65535 iterations in all, silently): 70,000
+// small triangles of one object around a few samples. The shader reports the samples it could
+// not finish and the backend computes them on the CPU, so they agree with the CPU twin.
+TEST(GlSelfVoronoi, SamplesBeyondADriversLoopCapAgreeWithTheCpu) {
+  VPROXQ_GL_CONTEXT_OR_FAIL(context);
+  SelfDvdInput in;
+  DvdInput& d = in.dvd;
+  d.grid.origin = Vec3(0, 0, 0);
+  d.grid.cell = 0.25;
+  d.grid.dims = {8, 8, 8};
+  std::mt19937 rng(71);
+  std::uniform_real_distribution<double> unit(0.8, 1.2);
+  for (std::int32_t t = 0; t < 70000; ++t) {
+    const Vec3 a(unit(rng), unit(rng), unit(rng));
+    for (const Vec3& c : {a, Vec3(a + Vec3(0.01, 0, 0)), Vec3(a + Vec3(0, 0.01, 0.003))})
+      for (int k = 0; k < 3; ++k) {
+        d.tri_xyz_d.push_back(c[k]);
+        d.tri_xyz.push_back(static_cast<float>(c[k]));
+      }
+    d.tri_site.push_back(0);
+    for (std::int32_t v = 0; v < 3; ++v) in.tri_vertices.push_back(3 * t + v);
+  }
+  for (std::int64_t v : {0, 73, 146, 292, 365, 511}) {
+    d.voxels.push_back(v);
+    d.band.push_back(2.0f);
+    in.sample_triangle.push_back(static_cast<std::int32_t>(v));
+  }
+  bin_triangles(d, 4);
+  Twin twin(context);
+  twin.compute(in);
+  expect_twin_agreement(twin);
+  std::cout << "70,000 triangles near 6 samples: " << twin.gpu.last_redone()
+            << " samples computed on the CPU (loop cap)\n";
 }
 
 TEST(GlSelfVoronoi, GeneratedMeshesAllBackendsEqualBruteForce) {

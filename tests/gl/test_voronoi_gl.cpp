@@ -414,6 +414,36 @@ TEST(GlVoronoi, GridsOfMoreThan2To32VoxelsMatchTheReference) {
   EXPECT_GT(stats.values, 0);
 }
 
+// A sample whose bins hold more triangles than one invocation may loop over on some drivers
+// (llvmpipe stops an invocation's loops after 65535 iterations in all, silently): 70,000
+// triangles of 5 sites around a few sample voxels. The shader reports the samples it could not
+// finish and the backend computes them on the CPU, so they still match the reference.
+TEST(GlVoronoi, SamplesBeyondADriversLoopCapMatchTheReference) {
+  VPROXQ_GL_CONTEXT_OR_FAIL(context);
+  GlVoronoiBackend backend(context);
+  DvdInput in;
+  in.grid.origin = Vec3(1.5, -2, 0.25);
+  in.grid.cell = 0.25;
+  in.grid.dims = {8, 8, 8};
+  std::mt19937 rng(70000);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int t = 0; t < 70000; ++t) {
+    const Vec3 a = in.grid.origin + Vec3(0.8 + 0.4 * unit(rng), 0.8 + 0.4 * unit(rng), 0.8 + 0.4 * unit(rng));
+    add_triangle(in, {a, a + Vec3(0.01, 0, 0), a + Vec3(0, 0.01, 0.003)}, t % 5);
+  }
+  for (std::int64_t v : {0, 9, 73, 146, 292, 365, 438, 511}) {
+    in.voxels.push_back(v);
+    in.band.push_back(2.0f);
+    in.exclude_site.push_back(v % 2 == 0 ? kNoIndex : 1);
+  }
+  bin_triangles(in, 4);
+  CheckStats stats;
+  const DvdOutput got = backend.compute(in);
+  check_against_reference(in, reference(in), got, backend.distance_error_bound(extent_of(in)), stats);
+  std::cout << "70,000 triangles near 8 samples on " << backend.device() << ": " << backend.last_redone()
+            << " samples computed on the CPU (loop cap)\n";
+}
+
 TEST(GlVoronoi, RejectsGridsTheShaderCannotAddress) {
   VPROXQ_GL_CONTEXT_OR_FAIL(context);
   GlVoronoiBackend backend(context);
