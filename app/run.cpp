@@ -267,18 +267,22 @@ void run(const Config& config) {
       result.time_ms.exact += sw.elapsed_ms();
     }
     if (next_frame) {
+      // The next frame's objects in this frame's order, by name where the files list them
+      // in another order (ccd_counterparts_by_name()).
+      const std::optional<Frame> reordered = ccd_counterparts_by_name(frame, *next_frame);
+      const Frame& to = reordered ? *reordered : *next_frame;
       // Stage II for CCD: records on the host, voxels and co-occupancy on the backend.
       sw.restart();
-      const CcdSweep sweep = CcdSweep::compute(frame, *next_frame, info.threads);
+      const CcdSweep sweep = CcdSweep::compute(frame, to, info.threads);
       const double sweep_ms = sw.elapsed_ms();
       std::optional<CcdVoxelCulling> voxels;
       double voxel_ms = 0;
       if (voronoi.backend) {
         sw.restart();
-        voxels.emplace(frame, *next_frame, sweep, CcdVoxelOptions{grid, 0, info.threads}, *voronoi.ccd_backend);
+        voxels.emplace(frame, to, sweep, CcdVoxelOptions{grid, 0, info.threads}, *voronoi.ccd_backend);
         voxel_ms = sw.elapsed_ms();
       }
-      CcdStepResult c = continuous_collisions(frame, *next_frame, sweep,
+      CcdStepResult c = continuous_collisions(frame, to, sweep,
                                               CcdOptions{info.threads, voxels ? &*voxels : nullptr});
       c.aabb_ms += sweep_ms;
       c.voronoi_ms = voxel_ms;

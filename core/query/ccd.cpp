@@ -275,6 +275,32 @@ constexpr Index kChunk = 256;  ///< triangles per unit of parallel work
 
 }  // namespace
 
+std::optional<Frame> ccd_counterparts_by_name(const Frame& from, const Frame& to) {
+  bool same_order = from.objects.size() == to.objects.size();
+  for (size_t i = 0; same_order && i < from.objects.size(); ++i)
+    same_order = from.objects[i].name == to.objects[i].name;
+  if (same_order) return std::nullopt;
+  std::unordered_map<std::string, size_t> where;
+  for (size_t k = 0; k < to.objects.size(); ++k)
+    if (!where.emplace(to.objects[k].name, k).second) return std::nullopt;  // a name twice
+  std::unordered_map<std::string, size_t> seen;
+  for (size_t i = 0; i < from.objects.size(); ++i)
+    if (!seen.emplace(from.objects[i].name, i).second) return std::nullopt;
+  Frame aligned;
+  aligned.index = to.index;
+  aligned.files = to.files;
+  aligned.objects.resize(from.objects.size());
+  for (size_t i = 0; i < from.objects.size(); ++i) {
+    const auto it = where.find(from.objects[i].name);
+    if (it != where.end()) {
+      aligned.objects[i] = to.objects[it->second];
+    } else {
+      aligned.objects[i].name = from.objects[i].name;  // no topology: no counterpart
+    }
+  }
+  return aligned;
+}
+
 CcdParticipants ccd_participants(const Frame& from, const Frame& to) {
   CcdParticipants p;
   std::unordered_map<std::string, size_t> to_names;  // built when first needed
@@ -287,6 +313,10 @@ CcdParticipants ccd_participants(const Frame& from, const Frame& to) {
       continue;
     }
     const Object& b = to.objects[i];
+    if (!b.topology) {
+      p.skipped.push_back({id, "no object named '" + a.name + "' in frame " + std::to_string(to.index)});
+      continue;
+    }
     if (a.name != b.name) {
       // Objects are matched by position. When this object's name is found at another
       // position of the next frame (and not here), the files list their objects in another

@@ -3,7 +3,8 @@
 // edge–edge pair that collides while the vertices move linearly from frame k to frame k+1,
 // inter-object and intra-object, with its earliest time of impact.
 //
-// Pipeline: objects are matched by position in the frames' lists; an object whose counterpart
+// Pipeline: objects are matched by position in the frames' lists (the CLI first reorders the
+// next frame by name where it can: ccd_counterparts_by_name()); an object whose counterpart
 // is missing, whose topology differs or whose name is found at another position of the next
 // frame (objects listed in another order) is skipped for the step (CcdStepResult::skipped).
 // Stage I: swept boxes (the box of a triangle's 6 positions, widened by the culling margin
@@ -31,6 +32,8 @@
 #include "core/results.hpp"
 #include "core/scene.hpp"
 
+#include <optional>
+
 namespace vproxq {
 
 class CcdVoxelCulling;
@@ -48,6 +51,14 @@ struct CcdParticipants {
   std::vector<CcdSkipped> skipped;
 };
 CcdParticipants ccd_participants(const Frame& from, const Frame& to);
+
+/// The objects of `to` in `from`'s order, by name: object i of the result is the object of `to`
+/// named like from.objects[i] (files that list their objects in another order, the pieces of
+/// a breaking object renumbered), or, when `to` has no object of that name, an object without
+/// topology (ccd_participants() skips it: no counterpart). Nullopt when no reordering is
+/// needed (every object has its name at the same position in `to`) or possible (a name occurs
+/// twice in either frame: objects are then matched by position).
+std::optional<Frame> ccd_counterparts_by_name(const Frame& from, const Frame& to);
 
 /// Swept geometry of a step shared by Stage I, II and III.
 struct CcdSweep {

@@ -138,6 +138,40 @@ TEST(CcdPipeline, ObjectsListedInAnotherOrderAreSkipped) {
   expect_same_ccd(r, continuous_collisions_brute_force(from, to));
 }
 
+// The CLI matches objects by name when the files list them in another order (or a breaking
+// object's pieces are renumbered): CCD over the reordered next frame equals CCD over the same
+// frame listed in the original order.
+TEST(CcdPipeline, CounterpartsByNameFollowObjectsListedInAnotherOrder) {
+  Frame from = test::make_random_frame(7, 4, 1.2, 1);
+  from.index = 0;
+  const Frame to = moved(from, 9, 0.5, 0.25);
+  Frame shuffled = to;
+  std::swap(shuffled.objects[0], shuffled.objects[3]);
+  std::swap(shuffled.objects[1], shuffled.objects[2]);
+  EXPECT_FALSE(ccd_counterparts_by_name(from, to).has_value());  // already in order
+  const std::optional<Frame> aligned = ccd_counterparts_by_name(from, shuffled);
+  ASSERT_TRUE(aligned.has_value());
+  const CcdStepResult ref = continuous_collisions_brute_force(from, to);
+  EXPECT_FALSE(ref.vf.empty() && ref.ee.empty());
+  EXPECT_TRUE(ref.skipped.empty());
+  expect_same_ccd(continuous_collisions(from, *aligned, CcdOptions{2, nullptr}), ref);
+
+  // A name missing from the next frame: that object is skipped, the others are matched.
+  Frame fewer = shuffled;
+  fewer.objects.erase(fewer.objects.begin());  // to's object 3
+  const std::optional<Frame> partial = ccd_counterparts_by_name(from, fewer);
+  ASSERT_TRUE(partial.has_value());
+  const CcdStepResult r = continuous_collisions(from, *partial, CcdOptions{2, nullptr});
+  ASSERT_EQ(r.skipped.size(), 1u);
+  EXPECT_EQ(r.skipped[0].object, 3);
+  EXPECT_NE(r.skipped[0].reason.find("no object named"), std::string::npos) << r.skipped[0].reason;
+
+  // A name given twice: no matching by name (objects are then matched by position).
+  Frame twice = shuffled;
+  twice.objects[1].name = twice.objects[0].name;
+  EXPECT_FALSE(ccd_counterparts_by_name(from, twice).has_value());
+}
+
 TEST(CcdPipeline, IncidentPairsAreExcludedButNeighboursAreTested) {
   // Two triangles sharing vertex 0; the tip of the second (vertex 3) swings through the first.
   auto topo = std::make_shared<Topology>();
