@@ -284,8 +284,14 @@ std::optional<Frame> ccd_counterparts_by_name(const Frame& from, const Frame& to
   for (size_t k = 0; k < to.objects.size(); ++k)
     if (!where.emplace(to.objects[k].name, k).second) return std::nullopt;  // a name twice
   std::unordered_map<std::string, size_t> seen;
-  for (size_t i = 0; i < from.objects.size(); ++i)
+  bool moved = false;  // some object's name is found at another position
+  for (size_t i = 0; i < from.objects.size(); ++i) {
     if (!seen.emplace(from.objects[i].name, i).second) return std::nullopt;
+    const auto it = where.find(from.objects[i].name);
+    moved = moved || (it != where.end() && it->second != i);
+  }
+  // Names that match nowhere else (taken from each frame's file name, say) say nothing.
+  if (!moved) return std::nullopt;
   Frame aligned;
   aligned.index = to.index;
   aligned.files = to.files;

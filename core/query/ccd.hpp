@@ -55,9 +55,10 @@ CcdParticipants ccd_participants(const Frame& from, const Frame& to);
 /// The objects of `to` in `from`'s order, by name: object i of the result is the object of `to`
 /// named like from.objects[i] (files that list their objects in another order, the pieces of
 /// a breaking object renumbered), or, when `to` has no object of that name, an object without
-/// topology (ccd_participants() skips it: no counterpart). Nullopt when no reordering is
-/// needed (every object has its name at the same position in `to`) or possible (a name occurs
-/// twice in either frame: objects are then matched by position).
+/// topology (ccd_participants() skips it: no counterpart). Nullopt, for matching by position,
+/// when no object's name is found at another position of `to` (names in the same order, or
+/// names that change with every frame, such as file names) or when a name occurs twice in
+/// either frame.
 std::optional<Frame> ccd_counterparts_by_name(const Frame& from, const Frame& to);
 
 /// Swept geometry of a step shared by Stage I, II and III.

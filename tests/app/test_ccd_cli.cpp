@@ -169,5 +169,37 @@ TEST(CcdCli, TopologyChangeIsSkippedWithReason) {
   EXPECT_EQ(reasons[0], skipped[0]["reason"].get<std::string>());
 }
 
+// Objects named after each frame's file (a PLY frame holds one unnamed mesh) are matched by
+// position; objects listed in another order in the next file are matched by name. Either way
+// nothing is skipped and the collision is reported.
+TEST(CcdCli, ObjectsAreMatchedAcrossFramesByPositionOrByName) {
+  ScratchDir dir;
+  auto ply = [](double z) {
+    return "ply\nformat ascii 1.0\nelement vertex 6\nproperty double x\nproperty double y\n"
+           "property double z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+           "0 0 0\n2 0 0\n0 2 0\n0.5 0.5 " + std::to_string(z) + "\n0.5 0.5 " + std::to_string(z + 1) +
+           "\n0.5 1.5 " + std::to_string(z + 1) + "\n3 0 1 2\n3 3 4 5\n";
+  };
+  dir.write("a.ply", ply(0.5));
+  dir.write("b.ply", ply(-0.5));
+  auto r = vproxq(quote(dir.write("s1.json", R"({"frames": {"files": ["a.ply", "b.ply"]}})")) +
+                  " --queries ccd --quiet -o " + quote(dir / "by_position"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  auto ccd = read_json(dir / "by_position" / "results.json")["frames"][0]["ccd"];
+  EXPECT_TRUE(ccd["skipped"].empty()) << ccd.dump();
+  EXPECT_EQ(ccd["pairs"].size(), 1u) << ccd.dump();
+
+  const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  dir.write("o_0.obj", "o a\n" + tri + "f 1 2 3\no b\nv 0.2 0.2 0.5\nv 0.2 0.2 1.5\nv 0.2 1.2 1.5\nf 4 5 6\n");
+  dir.write("o_1.obj", "o b\nv 0.2 0.2 -0.5\nv 0.2 0.2 0.5\nv 0.2 1.2 0.5\nf 1 2 3\no a\n" + tri + "f 4 5 6\n");
+  r = vproxq(quote(dir.write("s2.json", R"({"frames": {"files": ["o_0.obj", "o_1.obj"]}})")) +
+             " --queries ccd --quiet -o " + quote(dir / "by_name"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ccd = read_json(dir / "by_name" / "results.json")["frames"][0]["ccd"];
+  EXPECT_TRUE(ccd["skipped"].empty()) << ccd.dump();
+  ASSERT_EQ(ccd["pairs"].size(), 1u) << ccd.dump();
+  EXPECT_EQ(ccd["pairs"][0]["objects"], nlohmann::json::parse("[0, 1]"));
+}
+
 }  // namespace
 }  // namespace vproxq

@@ -170,6 +170,12 @@ TEST(CcdPipeline, CounterpartsByNameFollowObjectsListedInAnotherOrder) {
   Frame twice = shuffled;
   twice.objects[1].name = twice.objects[0].name;
   EXPECT_FALSE(ccd_counterparts_by_name(from, twice).has_value());
+
+  // Names that change with every frame (each file's name) and are found nowhere else: matched
+  // by position, nothing skipped.
+  Frame renamed = to;
+  for (Object& o : renamed.objects) o.name += "-next";
+  EXPECT_FALSE(ccd_counterparts_by_name(from, renamed).has_value());
 }
 
 TEST(CcdPipeline, IncidentPairsAreExcludedButNeighboursAreTested) {
