@@ -79,24 +79,42 @@ std::vector<SweptTriangle> swept_triangles(const Object& from, const Object& to)
   return out;
 }
 
-/// Whether triangles a and b stay more than `gap` apart for the whole step, shown along one
-/// axis w: at time t, (smallest projection of b's corners) - (largest of a's) is a minimum of
-/// linear functions of t minus a maximum of linear functions, so it is concave in t and at
-/// least its smaller end value; when that value exceeds gap |w| at t = 0 and at t = 1 (or the
-/// same with a and b swapped), every point of b is more than `gap` from every point of a at
-/// every time. Axes: both normals at the start and the line through the centroids at the
-/// start (any axis is valid: the gap is compared with |w| itself); x, y and z are the same
-/// test on the triangles' boxes at both ends (apart_at_both_ends, done first, being cheaper).
-/// The dot products are off by a few 2^-53 |w| M (M: largest coordinate), far below the
-/// rounding slack that `gap` includes.
-bool swept_apart(const SweptTriangle& a, const SweptTriangle& b, double gap) {
-  auto apart_along = [&](const Vec3& w) {
-    const ProjectionGaps g0 = projection_gaps(a.start, b.start, w);
-    const ProjectionGaps g1 = projection_gaps(a.end, b.end, w);
-    const double d = std::max(std::min(g0.b_above_a, g1.b_above_a), std::min(g0.a_above_b, g1.a_above_b));
-    return d > 0 && d * d > gap * gap * w.squaredNorm();
+/// Whether the points a (each moving linearly from a_start to a_end) and the points b stay
+/// more than `gap` apart along the axis w for the whole step, hence so do their convex hulls:
+/// at time t, (smallest projection of b) - (largest of a) is a minimum of linear functions of t
+/// minus a maximum of linear functions, so it is concave and at least its smaller end value
+/// (the same with a and b swapped). The gap is compared with |w| itself, so w need not be a
+/// unit vector; the dot products are off by a few 2^-53 |w| M (M: largest coordinate), far
+/// below the rounding slack that `gap` includes.
+template <std::size_t NA, std::size_t NB>
+bool points_apart_along(const std::array<Vec3, NA>& a_start, const std::array<Vec3, NA>& a_end,
+                        const std::array<Vec3, NB>& b_start, const std::array<Vec3, NB>& b_end,
+                        const Vec3& w, double gap) {
+  auto gaps = [&w](const std::array<Vec3, NA>& a, const std::array<Vec3, NB>& b) {
+    double a_lo = kInfinity, a_hi = -kInfinity, b_lo = kInfinity, b_hi = -kInfinity;
+    for (const Vec3& x : a) {
+      a_lo = std::min(a_lo, w.dot(x));
+      a_hi = std::max(a_hi, w.dot(x));
+    }
+    for (const Vec3& x : b) {
+      b_lo = std::min(b_lo, w.dot(x));
+      b_hi = std::max(b_hi, w.dot(x));
+    }
+    return ProjectionGaps{b_lo - a_hi, a_lo - b_hi};
   };
-  return apart_along(a.normal) || apart_along(b.normal) || apart_along(b.corner_sum - a.corner_sum);
+  const ProjectionGaps g0 = gaps(a_start, b_start), g1 = gaps(a_end, b_end);
+  const double d = std::max(std::min(g0.b_above_a, g1.b_above_a), std::min(g0.a_above_b, g1.a_above_b));
+  return d > 0 && d * d > gap * gap * w.squaredNorm();
+}
+
+/// Whether triangles a and b stay more than `gap` apart for the whole step, shown by
+/// points_apart_along() on both normals at the start and the line through the centroids at
+/// the start (any axis is valid); x, y and z are the same test on the triangles' boxes at both
+/// ends (apart_at_both_ends, done first, being cheaper).
+bool swept_apart(const SweptTriangle& a, const SweptTriangle& b, double gap) {
+  return points_apart_along(a.start, a.end, b.start, b.end, a.normal, gap) ||
+         points_apart_along(a.start, a.end, b.start, b.end, b.normal, gap) ||
+         points_apart_along(a.start, a.end, b.start, b.end, b.corner_sum - a.corner_sum, gap);
 }
 
 /// A vertex and a face's corners (NA = 1, NB = 3) or two edges' end points (2, 2), at the
@@ -108,33 +126,16 @@ struct SweptPrimitives {
 };
 
 /// Whether two primitives stay more than `gap` apart for the whole step, shown along x, y, z
-/// or one of `axes`: swept_apart()'s argument, with the primitives' own points (every point of
+/// or one of `axes` (points_apart_along()), with the primitives' own points (every point of
 /// a primitive is a convex combination of them, so its projection lies between theirs). A
 /// pair this rules out is one the elementary test cannot report (gap: see apart_gap below).
 /// Along a coordinate axis the projections are the coordinates themselves (exact).
 template <std::size_t NA, std::size_t NB>
 bool primitives_apart(const SweptPrimitives<NA, NB>& p, std::initializer_list<Vec3> axes, double gap) {
-  auto apart_along = [&](const Vec3& w) {
-    auto gaps = [&](const std::array<Vec3, NA>& a, const std::array<Vec3, NB>& b) {
-      double a_lo = kInfinity, a_hi = -kInfinity, b_lo = kInfinity, b_hi = -kInfinity;
-      for (const Vec3& x : a) {
-        a_lo = std::min(a_lo, w.dot(x));
-        a_hi = std::max(a_hi, w.dot(x));
-      }
-      for (const Vec3& x : b) {
-        b_lo = std::min(b_lo, w.dot(x));
-        b_hi = std::max(b_hi, w.dot(x));
-      }
-      return ProjectionGaps{b_lo - a_hi, a_lo - b_hi};
-    };
-    const ProjectionGaps g0 = gaps(p.a_start, p.b_start), g1 = gaps(p.a_end, p.b_end);
-    const double d = std::max(std::min(g0.b_above_a, g1.b_above_a), std::min(g0.a_above_b, g1.a_above_b));
-    return d > 0 && d * d > gap * gap * w.squaredNorm();
-  };
   for (int k = 0; k < 3; ++k)
-    if (apart_along(Vec3::Unit(k))) return true;
+    if (points_apart_along(p.a_start, p.a_end, p.b_start, p.b_end, Vec3::Unit(k), gap)) return true;
   for (const Vec3& w : axes)
-    if (apart_along(w)) return true;
+    if (points_apart_along(p.a_start, p.a_end, p.b_start, p.b_end, w, gap)) return true;
   return false;
 }
 
