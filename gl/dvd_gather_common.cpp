@@ -73,6 +73,19 @@ void DvdSharedBuffers::bind() const {
   bin_tris.bind(3);
 }
 
+DvdInput with_samples(const DvdInput& in, const std::vector<std::size_t>& picks) {
+  DvdInput part = in;
+  part.voxels.clear();
+  part.band.clear();
+  part.exclude_site.clear();
+  for (const std::size_t k : picks) {
+    part.voxels.push_back(in.voxels[k]);
+    part.band.push_back(in.band[k]);
+    if (!in.exclude_site.empty()) part.exclude_site.push_back(in.exclude_site[k]);
+  }
+  return part;
+}
+
 std::vector<std::uint32_t> pack_samples(const DvdInput& in, std::size_t first, std::size_t count) {
   std::vector<std::uint32_t> samples(4 * count);
   const std::int64_t dx = in.grid.dims[0], dy = in.grid.dims[1];

@@ -37,6 +37,11 @@ struct DvdSharedBuffers {
   void bind() const;
 };
 
+/// `in` with only the sample voxels `picks` (indices into in.voxels, in that order): their
+/// bands and exclusions, the same grid, triangles and bins. For computing the samples a
+/// shader could not finish with the CPU twin.
+DvdInput with_samples(const DvdInput& in, const std::vector<std::size_t>& picks);
+
 /// Binding 4 of a batch: per sample, its voxel coordinates (x, y, z) and the float bits of its
 /// band.
 std::vector<std::uint32_t> pack_samples(const DvdInput& in, std::size_t first, std::size_t count);

@@ -99,16 +99,10 @@ SelfDvdOutput GlSelfVoronoiBackend::compute(const SelfDvdInput& self) {
   // by the CPU twin, whose error bound is below this backend's; their last_nearest() is -1.
   last_redone_ = redo.size();
   if (!redo.empty()) {
-    SelfDvdInput part = self;
-    part.dvd.voxels.clear();
-    part.dvd.band.clear();
-    part.dvd.exclude_site.clear();
-    part.sample_triangle.clear();
-    for (const std::size_t k : redo) {
-      part.dvd.voxels.push_back(in.voxels[k]);
-      part.dvd.band.push_back(in.band[k]);
-      part.sample_triangle.push_back(self.sample_triangle[k]);
-    }
+    SelfDvdInput part;
+    part.dvd = with_samples(in, redo);
+    part.tri_vertices = self.tri_vertices;
+    for (const std::size_t k : redo) part.sample_triangle.push_back(self.sample_triangle[k]);
     const SelfDvdOutput cpu = make_cpu_self_voronoi_backend(resolve_threads(0))->compute(part);
     for (std::size_t j = 0; j < redo.size(); ++j) {
       out.dist[redo[j]] = cpu.dist[j];

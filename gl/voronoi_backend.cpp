@@ -197,16 +197,7 @@ DvdOutput GlVoronoiBackend::compute(const DvdInput& in) {
     if (out.site1[k] == kShaderIncomplete) redo.push_back(k);
   last_redone_ = redo.size();
   if (!redo.empty()) {
-    DvdInput part = in;
-    part.voxels.clear();
-    part.band.clear();
-    part.exclude_site.clear();
-    for (const std::size_t k : redo) {
-      part.voxels.push_back(in.voxels[k]);
-      part.band.push_back(in.band[k]);
-      part.exclude_site.push_back(in.exclude_site.empty() ? kNoIndex : in.exclude_site[k]);
-    }
-    const DvdOutput cpu = make_cpu_voronoi_backend(resolve_threads(0))->compute(part);
+    const DvdOutput cpu = make_cpu_voronoi_backend(resolve_threads(0))->compute(with_samples(in, redo));
     for (std::size_t j = 0; j < redo.size(); ++j) {
       out.site1[redo[j]] = cpu.site1[j];
       out.site2[redo[j]] = cpu.site2[j];
