@@ -21,24 +21,6 @@ IndexRows make_rows(std::size_t rows, std::vector<std::pair<Index, Index>> pairs
   return out;
 }
 
-/// Rows 0..rows-1, row r being what fill(r, row) appends, sorted, duplicates removed. Sorting
-/// each short row on its own is much cheaper than sorting all (row, value) pairs at once.
-template <typename Fill>
-IndexRows make_rows_by_row(std::size_t rows, const Fill& fill) {
-  IndexRows out;
-  out.offsets.assign(rows + 1, 0);
-  std::vector<Index> row;
-  for (std::size_t r = 0; r < rows; ++r) {
-    row.clear();
-    fill(r, row);
-    std::sort(row.begin(), row.end());
-    row.erase(std::unique(row.begin(), row.end()), row.end());
-    out.values.insert(out.values.end(), row.begin(), row.end());
-    out.offsets[r + 1] = static_cast<Index>(out.values.size());
-  }
-  return out;
-}
-
 }  // namespace
 
 Adjacency::Adjacency(const Topology& topology) {
@@ -75,40 +57,71 @@ Adjacency::Adjacency(const Topology& topology) {
     }
   edge_tris_ = make_rows(edges_.size(), std::move(edge_pairs));
 
-  // 1-ring: the triangles of the three vertices, minus t itself.
-  ring1_ = make_rows_by_row(nt, [&](std::size_t t, std::vector<Index>& row) {
-    for (Index v : topology.faces[t])
-      for (Index g : vertex_triangles(v))
-        if (g != static_cast<Index>(t)) row.push_back(g);
-  });
+  faces_ = topology.faces;
+}
 
-  // 2-ring: the 1-rings of the 1-ring, minus t and its 1-ring; that is, the triangles of the
-  // vertices of the 1-ring other than t's own (those of t's vertices are all in the 1-ring),
-  // minus t's 1-ring. Going through the vertices visits each of them once per t: the cost is
-  // the 1-ring plus the outer vertices' valences, where the 1-rings of the 1-ring would cost
-  // the square of a high valence per triangle (a fan of 5,000 triangles around one vertex
-  // took 93 s). mark[h] == t + 1: h is t, in its 1-ring, or already in its row;
-  // vmark[w] == t + 1: vertex w is t's or already expanded.
-  std::vector<std::size_t> mark(nt, 0);
-  std::vector<std::size_t> vmark(nv, 0);
-  ring2_ = make_rows_by_row(nt, [&](std::size_t t, std::vector<Index>& row) {
-    const IndexSpan own = ring1(static_cast<Index>(t));
-    mark[t] = t + 1;
-    for (Index g : own) mark[static_cast<std::size_t>(g)] = t + 1;
-    for (Index v : topology.faces[t]) vmark[static_cast<std::size_t>(v)] = t + 1;
-    for (Index g : own)
-      for (Index w : topology.faces[static_cast<std::size_t>(g)]) {
-        std::size_t& vm = vmark[static_cast<std::size_t>(w)];
-        if (vm == t + 1) continue;
-        vm = t + 1;
-        for (Index h : vertex_triangles(w)) {
-          std::size_t& m = mark[static_cast<std::size_t>(h)];
-          if (m == t + 1) continue;
-          m = t + 1;
-          row.push_back(h);
-        }
-      }
+std::vector<Index> Adjacency::ring1(Index t) const {
+  std::vector<Index> row;
+  for (Index v : faces_[static_cast<std::size_t>(t)])
+    for (Index g : vertex_triangles(v))
+      if (g != t) row.push_back(g);
+  std::sort(row.begin(), row.end());
+  row.erase(std::unique(row.begin(), row.end()), row.end());
+  return row;
+}
+
+std::vector<Index> Adjacency::ring2(Index t) const {
+  // The triangles of the 1-ring's vertices other than t's own (those of t's vertices are all
+  // in the 1-ring), minus the 1-ring.
+  const Face& f = faces_[static_cast<std::size_t>(t)];
+  std::vector<Index> row;
+  for (Index g : ring1(t))
+    for (Index w : faces_[static_cast<std::size_t>(g)]) {
+      if (w == f[0] || w == f[1] || w == f[2]) continue;
+      for (Index h : vertex_triangles(w))
+        if (!share_vertex(f, faces_[static_cast<std::size_t>(h)])) row.push_back(h);
+    }
+  std::sort(row.begin(), row.end());
+  row.erase(std::unique(row.begin(), row.end()), row.end());
+  return row;
+}
+
+IndexSpan Adjacency::ring2_vertices(Index t) const {
+  std::call_once(ring2_vertices_once_, [&] {
+    IndexRows rows;
+    rows.offsets.assign(faces_.size() + 1, 0);
+    auto walked = [&](Index v) { return vertex_triangles(v).size() <= kRingWalkValence; };
+    std::vector<Index> outer, tris, verts;  // scratch, reused per triangle
+    for (std::size_t u = 0; u < faces_.size(); ++u) {
+      const Face& f = faces_[u];
+      auto own = [&](Index v) { return v == f[0] || v == f[1] || v == f[2]; };
+      // The 1-ring's vertices other than f's own, through f's walked vertices; their
+      // triangles that share no vertex with f (2-ring triangles); those triangles' vertices.
+      outer.clear();
+      for (Index v : f)
+        if (walked(v))
+          for (Index g : vertex_triangles(v))
+            for (Index w : faces_[static_cast<std::size_t>(g)])
+              if (!own(w) && walked(w)) outer.push_back(w);
+      std::sort(outer.begin(), outer.end());
+      outer.erase(std::unique(outer.begin(), outer.end()), outer.end());
+      tris.clear();
+      for (Index w : outer)
+        for (Index h : vertex_triangles(w))
+          if (!share_vertex(f, faces_[static_cast<std::size_t>(h)])) tris.push_back(h);
+      std::sort(tris.begin(), tris.end());
+      tris.erase(std::unique(tris.begin(), tris.end()), tris.end());
+      verts.clear();
+      for (Index h : tris)
+        for (Index b : faces_[static_cast<std::size_t>(h)]) verts.push_back(b);
+      std::sort(verts.begin(), verts.end());
+      verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+      rows.values.insert(rows.values.end(), verts.begin(), verts.end());
+      rows.offsets[u + 1] = static_cast<Index>(rows.values.size());
+    }
+    ring2_vertices_ = std::move(rows);
   });
+  return ring2_vertices_.row(t);
 }
 
 Index Adjacency::find_edge(Index a, Index b) const {

@@ -1,8 +1,13 @@
 #pragma once
 // Connectivity derived from a Topology (paper 5.2.2): vertex–triangle incidence, the unique
 // edges, the 1-ring of each triangle (the triangles sharing at least one vertex with it: its
-// adjacent features) and the 2-ring. Computed once per Topology and cached with it; frames
-// that reuse a Topology (same faces) reuse its adjacency.
+// adjacent features) and the 2-ring. The incidence and the edges are computed once per
+// Topology and cached with it (frames that reuse a Topology, same faces, reuse them); the
+// rings are derived from the incidence when asked for, one triangle at a time, and not stored:
+// a vertex used by V triangles puts all of them in each other's 1-ring, so stored rings cost
+// memory of the order of V^2 (a cylinder whose caps are fans of 10,000 triangles needed 6 GB).
+// What the 2-ring bound needs per frame, the 2-ring's vertices, is cached (ring2_vertices()),
+// walked around such hubs.
 //
 // Behaviour on irregular meshes (documented in the README):
 //  - boundary and non-manifold edges: an edge simply lists every triangle that uses it (1, 2
@@ -15,6 +20,7 @@
 #include "core/mesh/topology.hpp"
 
 #include <cstddef>
+#include <mutex>
 #include <vector>
 
 namespace vproxq {
@@ -61,10 +67,22 @@ class Adjacency {
   /// Edge id of {a, b} (either order), or kNoIndex when no face has that edge.
   Index find_edge(Index a, Index b) const;
   /// The 1-ring of t: every other triangle sharing at least one vertex with t, ascending.
-  IndexSpan ring1(Index t) const { return ring1_.row(t); }
+  /// Computed on each call, in time of the order of the valences of t's vertices.
+  std::vector<Index> ring1(Index t) const;
   /// The 2-ring of t: triangles sharing a vertex with a triangle of the 1-ring, that are
-  /// neither t nor in its 1-ring, ascending.
-  IndexSpan ring2(Index t) const { return ring2_.row(t); }
+  /// neither t nor in its 1-ring, ascending. Computed on each call (the 1-ring's vertices'
+  /// valences).
+  std::vector<Index> ring2(Index t) const;
+
+  /// Vertices used by more than this many triangles are hubs, which ring2_vertices() does not
+  /// walk through.
+  static constexpr std::size_t kRingWalkValence = 64;
+  /// The vertices of t's 2-ring triangles that a walk from t's vertices through the 1-ring
+  /// reaches without passing through a hub (as a vertex of t or of the 1-ring): ascending,
+  /// none of them t's. Without hubs nearby, exactly the 2-ring's vertices; around a hub of
+  /// valence V, the whole 2-ring would cost of the order of V per triangle, V^2 in all.
+  /// Computed for every triangle on the first call (thread-safe) and cached.
+  IndexSpan ring2_vertices(Index t) const;
 
   /// True when faces f and g share a vertex (f == g included): "adjacent" in DESIGN.md.
   static bool share_vertex(const Face& f, const Face& g) {
@@ -79,8 +97,9 @@ class Adjacency {
   std::vector<std::array<Index, 2>> edges_;
   std::vector<std::array<Index, 3>> tri_edges_;
   IndexRows edge_tris_;
-  IndexRows ring1_;
-  IndexRows ring2_;
+  std::vector<Face> faces_;
+  mutable std::once_flag ring2_vertices_once_;
+  mutable IndexRows ring2_vertices_;
 };
 
 /// The adjacency of a topology, computed on first use and cached inside it (thread-safe).

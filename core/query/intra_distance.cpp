@@ -143,20 +143,23 @@ std::vector<std::vector<double>> ring2_upper_bounds(const Frame& frame, int thre
   const ObjectBlocks blocks(n_obj, [&](size_t i) { return ObjectBlocks::blocks_of(out[i].size()); });
   std::vector<const Adjacency*> adj(n_obj, nullptr);
   parallel_for(n_obj, threads, [&](size_t i) {
-    if (!out[i].empty()) adj[i] = &adjacency(*frame.objects[i].topology);
+    if (out[i].empty()) return;
+    adj[i] = &adjacency(*frame.objects[i].topology);
+    adj[i]->ring2_vertices(0);  // computed and cached on the first frame of a topology
   });
   parallel_for(blocks.size(), threads, [&](size_t item) {
     const auto [object, block] = blocks.locate(item);
     const size_t i = object;  // a plain variable: lambdas below capture it
     const Object& o = frame.objects[i];
+    const Adjacency& a = *adj[i];
     const auto& faces = o.topology->faces;
     for (size_t f = block * kBlock; f < std::min(out[i].size(), (block + 1) * kBlock); ++f) {
+      const Face& ff = faces[f];
       double best2 = kInfinity;
-      for (Index g : adj[i]->ring2(static_cast<Index>(f)))
-        for (Index a : faces[f])
-          for (Index b : faces[static_cast<size_t>(g)])
-            best2 = std::min(best2, (o.positions[static_cast<size_t>(a)] -
-                                     o.positions[static_cast<size_t>(b)]).squaredNorm());
+      for (Index b : a.ring2_vertices(static_cast<Index>(f)))
+        for (Index v : ff)
+          best2 = std::min(best2, (o.positions[static_cast<size_t>(v)] -
+                                   o.positions[static_cast<size_t>(b)]).squaredNorm());
       out[i][f] = std::sqrt(best2) * (1 + kUpperBoundWidening);
     }
   });

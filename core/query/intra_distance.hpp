@@ -18,6 +18,14 @@ struct SelfVoronoiBounds;
 /// candidate, and a vertex pair's distance bounds the triangle pair's). kInfinity when the
 /// 2-ring is empty. Cheap (no triangle–triangle tests): the 2-ring triangles are tested in
 /// Stage III like any other candidate, only when they survive culling.
+///
+/// The 2-ring's vertices come from Adjacency::ring2_vertices(), a walk from f's vertices to
+/// the 1-ring's other vertices and their triangles that skips vertices used by more than 64
+/// triangles (Adjacency::kRingWalkValence; as a vertex of f or of the 1-ring): the
+/// triangles around such a hub are all in each other's 1-rings, and walking through it would
+/// cost of the order of its valence squared. Where a hub is skipped the bound comes
+/// from the part of the 2-ring reached without it (larger, or kInfinity), which is still an
+/// upper bound; where no vertex of valence above 64 is near f, it is the whole 2-ring's.
 std::vector<std::vector<double>> ring2_upper_bounds(const Frame& frame, int threads);
 
 struct IntraDistanceOptions {

@@ -735,9 +735,10 @@ PenetrationDepth self_depth(const ObjectView& view, PdStatus surface,
   const Adjacency& adj = adjacency(*o.topology);
   for (auto it = first; it != last; ++it) {
     sets.unite(it->tri_a, it->tri_b);
-    for (Index t : {it->tri_a, it->tri_b})
-      for (Index u : adj.ring1(t))
-        if (hit[static_cast<size_t>(u)]) sets.unite(t, u);
+    for (Index t : {it->tri_a, it->tri_b})  // t's 1-ring (and t itself: a no-op)
+      for (Index v : o.topology->faces[static_cast<size_t>(t)])
+        for (Index u : adj.vertex_triangles(v))
+          if (hit[static_cast<size_t>(u)]) sets.unite(t, u);
   }
   std::vector<std::pair<Index, size_t>> keyed;  // (contact root, position), in pair order
   for (auto it = first; it != last; ++it) keyed.emplace_back(sets.find(it->tri_a), static_cast<size_t>(it - first));

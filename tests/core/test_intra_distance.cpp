@@ -79,19 +79,70 @@ TEST(IntraDistance, SortedScanReferenceEqualsBruteForce) {
                       intra_object_distance_brute_force(frame), name + ", sorted scan");
 }
 
-TEST(IntraDistance, Ring2BoundIsAnUpperBound) {
+/// The 2-ring bound by its definition: the smallest distance between a vertex of t and a
+/// vertex of a triangle of Adjacency::ring2(t), widened as ring2_upper_bounds() widens it.
+double ring2_bound_by_definition(const Object& o, Index t) {
+  const auto& faces = o.topology->faces;
+  double best2 = kInfinity;
+  for (Index g : adjacency(*o.topology).ring2(t))
+    for (Index a : faces[static_cast<size_t>(t)])
+      for (Index b : faces[static_cast<size_t>(g)])
+        best2 = std::min(best2, (o.positions[static_cast<size_t>(a)] - o.positions[static_cast<size_t>(b)]).squaredNorm());
+  return std::sqrt(best2) * (1 + 1e-12);
+}
+
+TEST(IntraDistance, Ring2BoundIsTheWholeRingsAndAnUpperBound) {
+  // No vertex of these meshes is used by more than 64 triangles: the bound is the whole
+  // 2-ring's.
   for (const auto& [name, frame] : scenes()) {
     const auto ref = intra_object_distance_brute_force(frame);
     const auto bound = ring2_upper_bounds(frame, 2);
-    for (size_t i = 0; i < frame.objects.size(); ++i) {
-      const Adjacency& adj = adjacency(*frame.objects[i].topology);
+    for (size_t i = 0; i < frame.objects.size(); ++i)
       for (Index t = 0; t < frame.objects[i].num_triangles(); ++t) {
         const double u = bound[i][static_cast<size_t>(t)];
         EXPECT_GE(u, ref.per_object[i].per_triangle[static_cast<size_t>(t)].distance) << name;
-        EXPECT_EQ(u == kInfinity, adj.ring2(t).empty()) << name << " triangle " << t;
+        EXPECT_EQ(u, ring2_bound_by_definition(frame.objects[i], t)) << name << " triangle " << t;
       }
-    }
   }
+}
+
+TEST(IntraDistance, Ring2BoundSkipsHubsAndStaysAnUpperBound) {
+  // A closed cylinder whose caps are fans of n triangles around a hub vertex (valence n): the
+  // walk skips the hubs, so cap triangles get their bound from the rim's side triangles.
+  const int n = 200;
+  std::vector<Vec3> p;
+  std::vector<Face> faces;
+  for (int z = 0; z < 2; ++z)
+    for (int k = 0; k < n; ++k) {
+      const double a = 2 * M_PI * k / n;
+      p.emplace_back(std::cos(a), std::sin(a), 0.3 * z);
+    }
+  p.emplace_back(0, 0, 0);
+  p.emplace_back(0, 0, 0.3);
+  const Index hub0 = 2 * n, hub1 = 2 * n + 1;
+  for (Index k = 0; k < n; ++k) {
+    const Index j = (k + 1) % n;
+    faces.push_back({hub0, j, k});
+    faces.push_back({hub1, n + k, n + j});
+    faces.push_back({k, j, n + j});
+    faces.push_back({k, n + j, n + k});
+  }
+  const Frame frame = frame_of({test::make_object(p, faces, "cylinder")});
+  const Object& o = frame.objects[0];
+  const auto ref = intra_object_distance_brute_force(frame);
+  const auto bound = ring2_upper_bounds(frame, 2);
+  for (Index t = 0; t < o.num_triangles(); ++t) {
+    const double u = bound[0][static_cast<size_t>(t)];
+    const double whole = ring2_bound_by_definition(o, t);
+    EXPECT_GE(u, ref.per_object[0].per_triangle[static_cast<size_t>(t)].distance) << t;
+    EXPECT_GE(u, whole) << t;
+    // Here the nearest vertices of every triangle's 2-ring are rim or side vertices next to
+    // it (2 sin(pi / n) away), which the walk reaches without a hub: the bound is the whole
+    // 2-ring's all the same.
+    EXPECT_EQ(u, whole) << t;
+    EXPECT_LT(u, 0.1) << t;
+  }
+  expect_same_intra(intra_object_distance(frame, {2}), ref, "cylinder with fan caps");
 }
 
 TEST(IntraDistance, IrregularMeshExclusionsAreByVertexSharing) {
