@@ -56,13 +56,30 @@ int ray_crossing(const Vec3& p, const Triangle& t, bool& on_surface) {
   return above == -s ? s : 0;  // ahead of p iff p.x < plane.x iff sign(n.(p-a)) == -sign(n.x)
 }
 
-/// Winding number of `o` around p through its BVH: only faces whose box meets the ray.
+/// Whether p lies on the closed triangle t (exact; degenerate triangles as the point sets
+/// they are).
+bool on_triangle(const Vec3& p, const Triangle& t) {
+  return segment_triangle_intersection(p, p, t).intersecting;
+}
+
+/// Winding number of `o` around p through its BVH: first whether p lies on a face (faces whose
+/// box contains p), then the crossings of the faces whose box meets the ray. The perturbed ray
+/// alone would see p on a face only when that face is not parallel to the ray and the
+/// perturbation keeps p's projection in it; a point on a face in a y = const or z = const
+/// plane, or on an edge the perturbation leaves, would get the winding number of a point next
+/// to it, which is inside for faces on one side.
 int winding_number(const Vec3& p, const Object& o, const TriangleBvh& bvh, bool& on_surface) {
+  on_surface = false;
+  AABB point;
+  point.lo = point.hi = p;
+  bvh.query(point, [] { return 0.0; }, [&](Index t, double) {
+    on_surface = on_surface || on_triangle(p, o.triangle(t));
+  });
+  if (on_surface) return 0;
   AABB ray;
   ray.lo = p;
   ray.hi = Vec3(kInfinity, p.y(), p.z());
   int w = 0;
-  on_surface = false;
   bvh.query(ray, [] { return 0.0; }, [&](Index t, double) {
     if (on_surface) return;
     w += ray_crossing(p, o.triangle(t), on_surface);
@@ -834,6 +851,11 @@ PenetrationDepth pair_depth(const std::vector<ObjectView>& views,
 
 int winding_number_brute_force(const Vec3& p, const Object& object, bool& on_surface) {
   on_surface = false;
+  for (Index t = 0; t < object.num_triangles(); ++t)
+    if (on_triangle(p, object.triangle(t))) {
+      on_surface = true;
+      return 0;
+    }
   int w = 0;
   for (Index t = 0; t < object.num_triangles(); ++t) {
     w += ray_crossing(p, object.triangle(t), on_surface);

@@ -56,7 +56,7 @@ PenetrationDepthOutput penetration_depth(const Frame& frame, const FrameBoxes& b
 /// Signed number of times the surface of `object` winds around p: +1 inside a closed,
 /// consistently outward-oriented surface, -1 inside an inward-oriented one, 0 outside (the
 /// exact count of signed crossings of a ray from p in +x, see above). Sets on_surface (and
-/// returns 0) when p lies on the surface as seen by the ray. Brute force over all triangles:
+/// returns 0) when p lies on a (closed) face of the surface. Brute force over all triangles:
 /// the reference for the BVH-accelerated version used by penetration_depth().
 int winding_number_brute_force(const Vec3& p, const Object& object, bool& on_surface);
 

@@ -177,19 +177,12 @@ TEST(PenetrationDepth, WindingNumberIsExactOnDegenerateRays) {
           EXPECT_EQ(wf, 0);
           ++outside;
         } else {
-          // On the boundary. The faces x = 0 and x = 1 cross the ray: p is reported on the
-          // surface when the perturbed point p' = p + (0, e, e^2) projects into them, i.e.
-          // y, z in [0, 1). Otherwise the count is the winding number around p', which is
-          // inside iff x in (0, 1) and y, z in [0, 1).
-          const bool yz = p.y() >= 0 && p.y() < 1 && p.z() >= 0 && p.z() < 1;
-          const bool expect_on = (p.x() == 0 || p.x() == 1) && yz;
-          EXPECT_EQ(on_surface, expect_on);
-          if (on_surface) {
-            ++on;
-          } else {
-            EXPECT_EQ(w, strictly(p.x()) && yz ? 1 : 0);
-            EXPECT_EQ(wf, -w);
-          }
+          // On the boundary, on any face: those parallel to the ray (y or z = 0 or 1) too,
+          // where the perturbed ray from p + (0, e, e^2) would see a point inside for
+          // y = 0 or z = 0.
+          EXPECT_TRUE(on_surface);
+          EXPECT_EQ(w, 0);
+          ++on;
         }
       }
   EXPECT_GT(inside, 300);
@@ -237,6 +230,38 @@ TEST(PenetrationDepth, OverlappingBoxesGiveDepthDAlongTheAxis) {
         }
       }
   }
+}
+
+TEST(PenetrationDepth, VerticesOnTheOtherSurfaceAreOutsideOnEveryFace) {
+  // A unit box B inside the box A = [0, 2]^3, lying on one face of A from inside. B's four
+  // vertices on that face are on A's surface, so not inside; the other four are. The six
+  // placements are the same configuration rotated and mirrored, so they must agree: before,
+  // a vertex on a face parallel to the inside test's +x ray counted as inside for the faces
+  // y = 0 and z = 0, which made B's inside vertices a set without outside neighbour
+  // (too_deep).
+  double depth0 = -1;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      SCOPED_TRACE("axis " + std::to_string(axis) + " side " + std::to_string(side));
+      Vec3 lo = Vec3::Constant(0.5);
+      lo[axis] = side == 0 ? 0.0 : 1.0;
+      const Frame frame = frame_of({make_box(Vec3::Zero(), Vec3::Constant(2), 1, "a"),
+                                    make_box(lo, Vec3::Ones(), 1, "b")});
+      const auto pd = run_pd(frame);
+      ASSERT_EQ(pd.size(), 1u);
+      EXPECT_EQ(pd[0].status, PdStatus::Ok) << pd_status_name(pd[0].status);
+      EXPECT_TRUE(pd[0].inside_vertices[0].empty());
+      std::vector<Index> strictly;
+      const Object& b = frame.objects[1];
+      for (Index v = 0; v < b.num_vertices(); ++v) {
+        const Vec3& p = b.positions[static_cast<size_t>(v)];
+        if ((p.array() > 0).all() && (p.array() < 2).all()) strictly.push_back(v);
+      }
+      EXPECT_EQ(strictly.size(), 4u);
+      EXPECT_EQ(pd[0].inside_vertices[1], strictly);
+      if (depth0 < 0) depth0 = pd[0].depth;
+      EXPECT_NEAR(pd[0].depth, depth0, 1e-12);
+    }
 }
 
 TEST(PenetrationDepth, OffsetBoxesUseTheDeepestVertex) {
