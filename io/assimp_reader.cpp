@@ -3,11 +3,16 @@
 #include "io/read_util.hpp"
 
 #include <assimp/postprocess.h>
+#include <assimp/config.h>
 #include <assimp/scene.h>
 #include <Eigen/Geometry>
 #include <assimp/Importer.hpp>
 
+#include <array>
+#include <cctype>
+#include <map>
 #include <string>
+#include <vector>
 
 namespace vproxq::io_detail {
 
@@ -39,7 +44,26 @@ void collect(const aiNode* node, const Affine& parent, bool is_root, std::vector
   for (unsigned c = 0; c < node->mNumChildren; ++c) collect(node->mChildren[c], t, false, out);
 }
 
-MeshGroup convert(const fs::path& file, const aiMesh& mesh, const MeshRef& ref) {
+/// Corners at bitwise-equal positions (after the node transform) become one vertex, numbered
+/// in the order of first use; -0 and +0 are equal. Positions and faces are rewritten in place.
+/// For STL only, which stores every facet with its own three corners (so a closed mesh would
+/// be a soup); formats with shared vertices keep assimp's.
+void weld(MeshGroup& g) {
+  std::map<std::array<double, 3>, Index> first;
+  std::vector<Index> to(g.positions.size());
+  std::vector<Vec3> kept;
+  for (std::size_t v = 0; v < g.positions.size(); ++v) {
+    const Vec3& p = g.positions[v];
+    const auto [it, added] = first.try_emplace({p.x(), p.y(), p.z()}, static_cast<Index>(kept.size()));
+    if (added) kept.push_back(p);
+    to[v] = it->second;
+  }
+  for (Face& f : g.faces)
+    for (Index& v : f) v = to[static_cast<std::size_t>(v)];
+  g.positions = std::move(kept);
+}
+
+MeshGroup convert(const fs::path& file, const aiMesh& mesh, const MeshRef& ref, bool welded) {
   const std::string mesh_name = mesh.mName.C_Str();
   const std::string label = mesh_name.empty() ? std::to_string(ref.mesh) : "'" + mesh_name + "'";
   MeshGroup g;
@@ -75,6 +99,7 @@ MeshGroup convert(const fs::path& file, const aiMesh& mesh, const MeshRef& ref) 
                          static_cast<Index>(face.mIndices[i + 1])});
     }
   }
+  if (welded) weld(g);
   return g;
 }
 
@@ -83,8 +108,12 @@ MeshGroup convert(const fs::path& file, const aiMesh& mesh, const MeshRef& ref) 
 std::vector<MeshGroup> read_with_assimp(const fs::path& file) {
   require_regular_file(file);
   Assimp::Importer importer;
+  // Coordinates as written: no rotation of Z_UP / X_UP Collada files to assimp's Y up.
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
   // Triangulate only: JoinIdenticalVertices and the other position-dependent steps would
-  // change topology from frame to frame.
+  // change topology from frame to frame. STL is welded by weld() instead: assimp's
+  // JoinIdenticalVertices also compares normals, so it keeps the corners of flat-shaded
+  // facets apart.
   const aiScene* scene = importer.ReadFile(file.string(), aiProcess_Triangulate);
   if (scene == nullptr) {
     throw_input_error(file, std::string("assimp: ") + importer.GetErrorString());
@@ -92,6 +121,10 @@ std::vector<MeshGroup> read_with_assimp(const fs::path& file) {
   if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0) {
     throw_input_error(file, "assimp: the scene is incomplete (no usable meshes)");
   }
+
+  std::string ext = file.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const bool stl = ext == ".stl";
 
   std::vector<MeshRef> refs;
   if (scene->mRootNode != nullptr) {
@@ -110,7 +143,7 @@ std::vector<MeshGroup> read_with_assimp(const fs::path& file) {
     }
     const aiMesh& mesh = *scene->mMeshes[ref.mesh];
     if (mesh.mNumFaces == 0) continue;
-    groups.push_back(convert(file, mesh, ref));
+    groups.push_back(convert(file, mesh, ref, stl));
   }
   const std::string stem = file.stem().string();
   for (std::size_t k = 0; k < groups.size(); ++k) {

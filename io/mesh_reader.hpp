@@ -17,8 +17,10 @@ struct MeshGroup {
 };
 
 /// Reads OBJ, PLY (ASCII and binary) and ASCII OFF with the project's own index-preserving,
-/// double precision readers; other formats through assimp (float precision, see README). Polygons
-/// are fan-triangulated. No welding, no reordering, no removal of degenerate faces.
+/// double precision readers; other formats through assimp (float precision, see README). The
+/// own readers fan-triangulate polygons and do no welding, no reordering and no removal of
+/// degenerate faces; through assimp, polygons are triangulated by assimp and STL corners at one
+/// position are welded (io/assimp_reader.cpp).
 /// Throws InputError naming the file and the problem.
 std::vector<MeshGroup> read_mesh_file(const std::filesystem::path& file);
 

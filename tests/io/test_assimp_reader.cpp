@@ -5,7 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <map>
+#include <string>
 #include <limits>
 
 namespace vproxq {
@@ -42,7 +45,10 @@ TEST(AssimpReader, PlyReaderAgreesWithAssimpOnTestData) {
   EXPECT_GE(checked, 7);  // two-cubes x3, cube, height-field, thick-cloth x2
 }
 
-TEST(AssimpReader, StlKeepsOneVertexPerCornerWithoutWelding) {
+TEST(AssimpReader, StlCornersAtOnePositionAreWelded) {
+  // STL stores each facet with its own three corners: read as they are, a closed mesh would
+  // be a soup (intra-object distance 0 between neighbours, PD open_surface, one component per
+  // triangle). Corners at the same position become one vertex, in the order of first use.
   TempDir dir;
   const auto file = dir.write("soup.stl",
                               "solid soup\n"
@@ -50,16 +56,73 @@ TEST(AssimpReader, StlKeepsOneVertexPerCornerWithoutWelding) {
                               "vertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
                               "endloop\nendfacet\n"
                               "facet normal 0 0 1\nouter loop\n"
-                              "vertex 1 0 0\nvertex 1 1 0\nvertex 0 1 0\n"
+                              "vertex 1 0 0\nvertex 1 1 0\nvertex -0 1 0\n"
+                              "endloop\nendfacet\n"
+                              "facet normal 0 0 1\nouter loop\n"
+                              "vertex 5 0 0\nvertex 6 0 0\nvertex 5 1e-30 0\n"
                               "endloop\nendfacet\n"
                               "endsolid soup\n");
   const auto groups = read_mesh_file(file);
   ASSERT_EQ(groups.size(), 1u);
   EXPECT_EQ(groups[0].name, "soup");
-  // STL is a triangle soup; no JoinIdenticalVertices, so shared corners stay apart.
-  EXPECT_EQ(groups[0].positions.size(), 6u);
-  EXPECT_EQ(groups[0].faces, (std::vector<Face>{{0, 1, 2}, {3, 4, 5}}));
-  EXPECT_EQ(groups[0].positions[4], Vec3(1, 1, 0));
+  EXPECT_EQ(groups[0].faces, (std::vector<Face>{{0, 1, 2}, {1, 3, 2}, {4, 5, 6}}));
+  ASSERT_EQ(groups[0].positions.size(), 7u);
+  EXPECT_EQ(groups[0].positions[3], Vec3(1, 1, 0));
+  EXPECT_EQ(groups[0].positions[6], Vec3(5, static_cast<double>(1e-30f), 0));  // not (5, 0, 0)
+
+  // A closed box as 12 STL facets: 8 vertices, every edge used twice, so PD is defined.
+  std::string stl = "solid box\n";
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  auto corner = [](int c) {
+    return std::to_string(c & 1) + " " + std::to_string((c >> 1) & 1) + " " + std::to_string((c >> 2) & 1);
+  };
+  for (const auto& q : quads)
+    for (const auto& tri : {std::array<int, 3>{q[0], q[1], q[2]}, std::array<int, 3>{q[0], q[2], q[3]}}) {
+      stl += "facet normal 0 0 0\nouter loop\n";
+      for (int c : tri) stl += "vertex " + corner(c) + "\n";
+      stl += "endloop\nendfacet\n";
+    }
+  stl += "endsolid box\n";
+  const auto box = read_mesh_file(dir.write("box.stl", stl));
+  ASSERT_EQ(box.size(), 1u);
+  EXPECT_EQ(box[0].positions.size(), 8u);
+  EXPECT_EQ(box[0].faces.size(), 12u);
+  std::map<std::pair<Index, Index>, int> directed;
+  for (const Face& f : box[0].faces)
+    for (int k = 0; k < 3; ++k) ++directed[{f[static_cast<size_t>(k)], f[static_cast<size_t>((k + 1) % 3)]}];
+  for (const auto& [e, n] : directed) {
+    EXPECT_EQ(n, 1);
+    EXPECT_EQ(directed.count({e.second, e.first}), 1u);
+  }
+}
+
+TEST(AssimpReader, ColladaCoordinatesAreTheFilesWhateverItsUpAxis) {
+  TempDir dir;
+  auto dae = [](const std::string& up) {
+    return "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"
+           "<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">\n"
+           "<asset><unit name=\"meter\" meter=\"1\"/><up_axis>" + up + "</up_axis></asset>\n"
+           "<library_geometries><geometry id=\"g\" name=\"tri\"><mesh>\n"
+           "<source id=\"p\"><float_array id=\"pa\" count=\"9\">1 1 0.5 2 1 0.5 1 3 0.5</float_array>\n"
+           "<technique_common><accessor source=\"#pa\" count=\"3\" stride=\"3\">"
+           "<param name=\"X\" type=\"float\"/><param name=\"Y\" type=\"float\"/><param name=\"Z\" type=\"float\"/>"
+           "</accessor></technique_common></source>\n"
+           "<vertices id=\"v\"><input semantic=\"POSITION\" source=\"#p\"/></vertices>\n"
+           "<triangles count=\"1\"><input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/><p>0 1 2</p></triangles>\n"
+           "</mesh></geometry></library_geometries>\n"
+           "<library_visual_scenes><visual_scene id=\"s\"><node id=\"n\" name=\"n\">"
+           "<instance_geometry url=\"#g\"/></node></visual_scene></library_visual_scenes>\n"
+           "<scene><instance_visual_scene url=\"#s\"/></scene>\n"
+           "</COLLADA>\n";
+  };
+  for (const std::string up : {"Z_UP", "Y_UP", "X_UP"}) {
+    SCOPED_TRACE(up);
+    const auto groups = read_mesh_file(dir.write("tri_" + up + ".dae", dae(up)));
+    ASSERT_EQ(groups.size(), 1u);
+    ASSERT_EQ(groups[0].positions.size(), 3u);
+    EXPECT_EQ(groups[0].positions[0], Vec3(1, 1, 0.5));
+    EXPECT_EQ(groups[0].positions[2], Vec3(1, 3, 0.5));
+  }
 }
 
 TEST(AssimpReaderErrors, MissingUnreadableAndUnknownFiles) {
