@@ -249,7 +249,7 @@ class ObjParser {
 }  // namespace
 
 std::vector<MeshGroup> read_obj(const fs::path& file, ObjGroups groups) {
-  const std::string text = read_whole_file(file);
+  const std::string text = read_text_file(file);
   ObjParser parser(file, text);
   parser.parse();
   return parser.result(groups);

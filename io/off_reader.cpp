@@ -261,7 +261,7 @@ class OffParser {
 }  // namespace
 
 MeshGroup read_off(const fs::path& file) {
-  const std::string text = read_whole_file(file);
+  const std::string text = read_text_file(file);
   OffParser parser(file, text);
   return parser.parse();
 }

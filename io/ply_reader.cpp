@@ -472,7 +472,8 @@ void read_body(const fs::path& file, const Header& h, Cursor& in, Where& where, 
 }  // namespace
 
 MeshGroup read_ply(const fs::path& file) {
-  const std::string bytes = read_whole_file(file);
+  std::string bytes = read_whole_file(file);
+  strip_utf8_bom(bytes);
   const Header h = parse_header(file, bytes);
   check_elements(file, h);
 

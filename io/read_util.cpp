@@ -1,9 +1,11 @@
 #include "io/read_util.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -39,6 +41,17 @@ std::string read_whole_file(const fs::path& file) {
   return bytes;
 }
 
+void strip_utf8_bom(std::string& bytes) {
+  if (bytes.compare(0, 3, "\xEF\xBB\xBF") == 0) bytes.erase(0, 3);
+}
+
+std::string read_text_file(const fs::path& file) {
+  std::string text = read_whole_file(file);
+  strip_utf8_bom(text);
+  if (text.find('\n') == std::string::npos) std::replace(text.begin(), text.end(), '\r', '\n');
+  return text;
+}
+
 bool parse_double(std::string_view token, double& out) {
   // std::from_chars rejects a leading '+', which some writers emit.
   if (token.size() > 1 && token[0] == '+' && token[1] != '-' && token[1] != '+') {
@@ -47,10 +60,13 @@ bool parse_double(std::string_view token, double& out) {
   if (token.empty()) return false;
   const char* end = token.data() + token.size();
   const auto [ptr, ec] = std::from_chars(token.data(), end, out, std::chars_format::general);
-  // ERANGE: a decimal number outside double's range; report it as non-finite, as it would
-  // be as a coordinate anyway (from_chars leaves `out` unchanged in that case).
+  // ERANGE: a decimal number beyond double's range (from_chars leaves `out` unchanged). Too
+  // large becomes +-inf (a non-finite coordinate), too small the smallest double of its sign
+  // (a coordinate too close to 0), so that each is reported as what it is, not read as 0.
   if (ec == std::errc::result_out_of_range && ptr == end) {
-    out = std::numeric_limits<double>::infinity();
+    const std::string text(token);
+    const double v = std::strtod(text.c_str(), nullptr);  // +-HUGE_VAL, or +-0 / subnormal
+    out = std::isinf(v) ? v : std::copysign(std::numeric_limits<double>::denorm_min(), v);
     return true;
   }
   return ec == std::errc() && ptr == end;

@@ -31,6 +31,13 @@ inline std::string_view next_token(std::string_view& rest) {
 /// file" / "cannot read file (<reason>)".
 std::string read_whole_file(const std::filesystem::path& file);
 
+/// Removes a UTF-8 byte order mark (EF BB BF) from the start of `bytes`, if there is one.
+void strip_utf8_bom(std::string& bytes);
+
+/// A text mesh file (OBJ, OFF) as read_whole_file() reads it, without a UTF-8 byte order mark,
+/// and with classic Mac line endings (CR alone, when the file has no LF at all) turned into LF.
+std::string read_text_file(const std::filesystem::path& file);
+
 /// Throws InputError unless `file` exists and is a regular file (same messages as above).
 void require_regular_file(const std::filesystem::path& file);
 

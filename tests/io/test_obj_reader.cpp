@@ -91,6 +91,17 @@ TEST(ObjReader, CoordinatesAreParsedAsDoubles) {
   }
 }
 
+TEST(ObjReader, ByteOrderMarkAndClassicMacLineEndings) {
+  TempDir dir;
+  for (const std::string& text : {std::string("\xEF\xBB\xBF# made by X\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+                                  std::string("# made by X\rv 0 0 0\rv 1 0 0\r\rv 0 1 0\rf 1 2 3\r")}) {
+    const auto groups = read_mesh_file(dir.write("t.obj", text));
+    ASSERT_EQ(groups.size(), 1u);
+    EXPECT_EQ(groups[0].positions[1], Vec3(1, 0, 0));
+    EXPECT_EQ(groups[0].faces, faces({{0, 1, 2}}));
+  }
+}
+
 TEST(ObjReader, CrlfTabsAndBlankLines) {
   TempDir dir;
   const auto file = dir.write("crlf.obj", "v\t0 0 0\r\n\r\n  v 1 0 0\r\nv 0 1 0\r\nf\t1 2 3\r\n");
@@ -267,6 +278,11 @@ TEST(ObjReaderErrors, CoordinateOutOfRangeNamesTheVertex) {
   const auto d = dir.write("tiny.obj", "v 0 0 0\nv 1 -1e-61 0\n");
   EXPECT_INPUT_ERROR(read_mesh_file(d), d.string() + ": line 2:", "vertex 2", "too close to 0",
                      "y = -1e-61;", "write 0");
+  // Below double's range: too close to 0 as well, not "non-finite" and not read as 0.
+  const auto e = dir.write("under.obj", "v 0 0 0\nv 1 -1e-400 0\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(e), e.string() + ": line 2:", "vertex 2", "too close to 0", "y = -5e-324;");
+  const auto f = dir.write("over.obj", "v 0 0 0\nv 1 -1e400 0\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(f), f.string() + ": line 2:", "vertex 2", "non-finite", "y = -inf");
   const auto c = dir.write("ok.obj", "v 1e60 -1e60 0\nv 1 6.3e-61 -0\nv 0 1 0\nf 1 2 3\n");
   const auto groups = read_mesh_file(c);
   ASSERT_EQ(groups.size(), 1u);

@@ -105,6 +105,17 @@ TEST(OffReader, CommentsBlankLinesAndCrlf) {
   EXPECT_EQ(read_off(unterminated).faces, faces({{0, 1, 2}}));
 }
 
+TEST(OffReader, ByteOrderMarkAndClassicMacLineEndings) {
+  TempDir dir;
+  for (const std::string& text : {std::string("\xEF\xBB\xBFOFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
+                                  std::string("OFF\r# c\r3 1 0\r0 0 0\r1 0 0\r0 1 0\r3 0 1 2\r")}) {
+    const auto groups = read_mesh_file(dir.write("t.off", text));
+    ASSERT_EQ(groups.size(), 1u);
+    EXPECT_EQ(groups[0].positions[1], Vec3(1, 0, 0));
+    EXPECT_EQ(groups[0].faces, (std::vector<Face>{{0, 1, 2}}));
+  }
+}
+
 TEST(OffReader, CountsOnTheKeywordLineOrWithoutKeyword) {
   TempDir dir;
   const auto same_line =

@@ -69,6 +69,18 @@ TEST(PlyReader, AsciiCrlfHeaderAndVertexIndexName) {
   EXPECT_EQ(groups[0].faces, faces({{0, 1, 2}}));
 }
 
+TEST(PlyReader, ByteOrderMark) {
+  TempDir dir;
+  const auto file = dir.write("bom.ply",
+                              "\xEF\xBB\xBFply\nformat ascii 1.0\nelement vertex 3\nproperty double x\n"
+                              "property double y\nproperty double z\nelement face 1\n"
+                              "property list uint8 uint32 vertex_indices\nend_header\n"
+                              "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  const auto groups = read_mesh_file(file);
+  EXPECT_EQ(groups[0].positions.size(), 3u);
+  EXPECT_EQ(groups[0].faces, faces({{0, 1, 2}}));
+}
+
 /// A binary PLY of kSquare (quad + triangle) with coordinates of type T.
 template <class T>
 std::string binary_square(bool big_endian, const char* type_name) {
