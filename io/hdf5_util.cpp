@@ -1,5 +1,7 @@
 #include "io/hdf5_util.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 
 namespace vproxq::h5 {
@@ -45,6 +47,12 @@ Handle vlen_string_type() {
     return Handle();
   }
   return type;
+}
+
+std::string valid_utf8(const std::string& text) {
+  const std::string quoted =
+      nlohmann::json(text).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  return nlohmann::json::parse(quoted).get<std::string>();
 }
 
 }  // namespace vproxq::h5

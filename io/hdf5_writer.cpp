@@ -351,7 +351,8 @@ struct Hdf5ResultWriter::Impl {
   }
   void write_attribute(hid_t owner, const std::string& owner_name, const char* name,
                        const std::string& value) const {
-    const char* text = value.c_str();
+    const std::string valid = h5::valid_utf8(value);
+    const char* text = valid.c_str();
     write_attribute(owner, owner_name, name, string_type.get(), string_type.get(), &text);
   }
   void write_attribute(hid_t owner, const std::string& owner_name, const char* name,
@@ -370,9 +371,11 @@ struct Hdf5ResultWriter::Impl {
   void write_attribute(hid_t owner, const std::string& owner_name, const char* name,
                        const std::vector<std::string>& values) const {
     const std::string where = owner_name + "@" + name;
+    std::vector<std::string> valid;
+    for (const std::string& v : values) valid.push_back(h5::valid_utf8(v));
     std::vector<const char*> texts;
     texts.reserve(values.size());
-    for (const std::string& v : values) texts.push_back(v.c_str());
+    for (const std::string& v : valid) texts.push_back(v.c_str());
     const hsize_t n[1] = {values.size()};
     Handle space(check_id(H5Screate_simple(1, n, nullptr), "H5Screate_simple", where), H5Sclose);
     Handle attr(check_id(H5Acreate2(owner, name, string_type.get(), space.get(), H5P_DEFAULT,
@@ -420,8 +423,10 @@ struct Hdf5ResultWriter::Impl {
 
   void write_objects(hid_t group, const std::string& where, const FrameResult& frame) const {
     std::vector<ObjectRow> rows;
+    std::vector<std::string> valid;
     std::vector<const char*> names;
     rows.reserve(frame.objects.size());
+    valid.reserve(frame.objects.size());
     names.reserve(frame.objects.size());
     for (const ObjectInfo& o : frame.objects) {
       ObjectRow row{};
@@ -430,7 +435,8 @@ struct Hdf5ResultWriter::Impl {
       row.triangles = o.triangles;
       row.is_static = o.is_static ? 1 : 0;
       rows.push_back(row);
-      names.push_back(o.name.c_str());
+      valid.push_back(h5::valid_utf8(o.name));
+      names.push_back(valid.back().c_str());
     }
     write_dataset(group, where, "objects", object_file_type.get(), object_mem_type.get(),
                   rows.size(), rows.data());
@@ -547,10 +553,13 @@ struct Hdf5ResultWriter::Impl {
     write_dataset(g, ccd_where, "pairs", ccd_pair_file_type.get(), ccd_pair_mem_type.get(),
                   pairs.size(), pairs.data());
     std::vector<std::int32_t> skipped;
+    std::vector<std::string> valid;
     std::vector<const char*> reasons;
+    valid.reserve(c.skipped.size());
     for (const CcdSkipped& s : c.skipped) {
       skipped.push_back(s.object);
-      reasons.push_back(s.reason.c_str());
+      valid.push_back(h5::valid_utf8(s.reason));
+      reasons.push_back(valid.back().c_str());
     }
     write_dataset(g, ccd_where, "skipped_objects", H5T_STD_I32LE, H5T_NATIVE_INT32, skipped.size(),
                   skipped.data());

@@ -435,6 +435,22 @@ TEST_F(OutputTest, Hdf5AndJsonRecordTheSameWriteTime) {
             bits(doc["frames"][0]["stats"]["time_ms"]["write"].get<double>()));
 }
 
+TEST_F(OutputTest, NamesThatAreNotUtf8AreTheSameValidTextInBothFiles) {
+  // Object names come from mesh files and may hold any bytes. The HDF5 strings are declared
+  // UTF-8, so invalid sequences become U+FFFD there as in results.json.
+  std::vector<FrameResult> frames = make_frames();
+  frames[0].objects[0].name = "bad\xff\xfe name \xc3\xa9 \xc3";
+  frames[0].files[0] = "frames/\xe9t\xe9.obj";
+  write_all(make_info(), frames);
+  const json doc = json::parse(read_text(out() / "results.json"));
+  Hdf5Reader h5(out() / "results.h5");
+  const std::string name = doc["frames"][0]["objects"][0]["name"].get<std::string>();
+  EXPECT_EQ(name, "bad\xef\xbf\xbd\xef\xbf\xbd name \xc3\xa9 \xef\xbf\xbd");
+  EXPECT_EQ(h5.strings_dataset("/frames/000000/object_names")[0], name);
+  EXPECT_EQ(h5.strings_attribute("/frames/000000", "files")[0], "frames/\xef\xbf\xbdt\xef\xbf\xbd.obj");
+  EXPECT_EQ(h5.strings_dataset("/frames/000000/object_names")[1], "blob1");
+}
+
 // The HDF5 writer closes and reopens its file every 1000 frames (to keep memory flat).
 TEST_F(OutputTest, ManyFramesAreAllWritten) {
   constexpr int kFrames = 1002;
