@@ -109,6 +109,10 @@ class OffParser {
       lines_.next(line);
       parse_face(line, f, out.faces);
     }
+    if (lines_.next(line)) {
+      fail("'" + abbreviate(line) + "' after the " + std::to_string(num_faces_) +
+           " faces the header declares (do the header's counts match the data?)");
+    }
     return out;
   }
 
@@ -143,13 +147,14 @@ class OffParser {
       fail("not an OFF file (expected 'OFF' or the counts 'vertices faces edges', got '" +
            abbreviate(line) + "')");
     }
-    if (w.size() != 3) {
+    // After a keyword, some writers leave out the edge count (which is not used anyway).
+    if (w.size() != 3 && !(k.known && w.size() == 2)) {
       fail("malformed OFF header: expected the counts 'vertices faces edges', got " +
            std::to_string(w.size()) + " values");
     }
     num_vertices_ = count(w[0], "vertex");
     num_faces_ = count(w[1], "face");
-    count(w[2], "edge");  // not used, but must be well formed
+    if (w.size() == 3) count(w[2], "edge");  // not used, but must be well formed
     if (num_vertices_ > std::numeric_limits<Index>::max()) {
       fail("too many vertices (" + std::to_string(num_vertices_) + "), at most " +
            std::to_string(std::numeric_limits<Index>::max()) + " are supported");

@@ -208,6 +208,7 @@ class BinaryCursor {
 
   std::size_t remaining() const { return static_cast<std::size_t>(end_ - p_); }
 
+
   double real(PlyType t) {
     if (t == PlyType::Float32) return static_cast<double>(get<float>());
     if (t == PlyType::Float64) return get<double>();
@@ -273,6 +274,23 @@ class AsciiCursor {
 
   std::size_t remaining() const { return static_cast<std::size_t>(end_ - p_); }
 
+  /// Throws unless only whitespace is left: values past the header's counts mean the counts
+  /// do not describe the file.
+  void expect_end() {
+    while (p_ < end_ && is_space_or_newline(*p_)) {
+      if (*p_ == '\n') ++line_;
+      ++p_;
+    }
+    if (p_ != end_) {
+      const char* b = p_;
+      while (p_ < end_ && !is_space_or_newline(*p_)) ++p_;
+      throw_input_error(*where_.file, "line " + std::to_string(line_) + ": '" +
+                                          abbreviate(std::string_view(b, static_cast<std::size_t>(p_ - b))) +
+                                          "' after the last element the header declares (do the "
+                                          "header's element counts match the data?)");
+    }
+  }
+
   double real(PlyType t) {
     const std::string_view tok = token();
     if (is_integer_type(t)) {
@@ -336,6 +354,17 @@ int face_list_property(const Element& e) {
 /// scalar x, y, z, and a face element (if any) with an integer index list.
 void check_elements(const fs::path& file, const Header& h) {
   bool has_vertex = false;
+  for (const Element& e : h.elements) {
+    for (std::size_t i = 0; i < e.props.size(); ++i)
+      for (std::size_t j = 0; j < i; ++j)
+        if (e.props[j].name == e.props[i].name)
+          throw_input_error(file, "malformed PLY header: element '" + abbreviate(e.name) +
+                                      "' declares property '" + abbreviate(e.props[i].name) + "' twice");
+    // Triangle strips would be skipped like any unknown element, losing the mesh's faces.
+    if ((e.name == "tristrips" || e.name == "tristrip") && e.count > 0)
+      throw_input_error(file, "element '" + e.name + "' (triangle strips) is not supported: "
+                              "store the faces as a 'face' element with 'vertex_indices' lists");
+  }
   for (const Element& e : h.elements) {
     if (e.name == "vertex") {
       has_vertex = true;
@@ -486,6 +515,7 @@ MeshGroup read_ply(const fs::path& file) {
         bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(h.data_offset), '\n'));
     AsciiCursor in(bytes, h.data_offset, header_lines + 1, where);
     read_body(file, h, in, where, out);
+    in.expect_end();
   } else {
     BinaryCursor in(bytes, h.data_offset, h.format == Format::BinaryLittleEndian, where);
     read_body(file, h, in, where, out);

@@ -93,7 +93,7 @@ TEST(OffReader, CommentsBlankLinesAndCrlf) {
                               "# faces\r\n"
                               "3 0 1 2 # the only face\r\n"
                               "# the end\r\n"
-                              "this and anything else after the declared faces is ignored\r\n");
+                              "\r\n");
   const MeshGroup g = read_off(file);
   EXPECT_EQ(g.name, "commented");
   EXPECT_EQ(g.positions, (std::vector<Vec3>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
@@ -118,6 +118,12 @@ TEST(OffReader, ByteOrderMarkAndClassicMacLineEndings) {
 
 TEST(OffReader, CountsOnTheKeywordLineOrWithoutKeyword) {
   TempDir dir;
+  // After the keyword the edge count may be left out.
+  const auto two = dir.write("two.off", "OFF\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  EXPECT_EQ(read_off(two).faces, faces({{0, 1, 2}}));
+  // Data past the declared faces: the counts do not describe the file.
+  const auto more = dir.write("more.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 2 1 0\n# end\n");
+  EXPECT_INPUT_ERROR(read_off(more), more.string() + ": line 7: '3 2 1 0' after the 1 faces");
   const auto same_line =
       dir.write("same_line.off", "OFF 4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n");
   const MeshGroup a = read_off(same_line);
@@ -221,8 +227,8 @@ TEST(OffReaderErrors, MalformedHeaders) {
       {"nOFF\n3\n3 1 0\n", ": line 1: 'nOFF' (n-dimensional vertices) is not supported"},
       {"OFF\n", "malformed OFF header: the file ends before the counts line"},
       {"OFF\n# counts missing\n", "malformed OFF header: the file ends before the counts line"},
-      {"OFF\n3 1\n",
-       ": line 2: malformed OFF header: expected the counts 'vertices faces edges', got 2 values"},
+      {"OFF\n3\n",
+       ": line 2: malformed OFF header: expected the counts 'vertices faces edges', got 1 values"},
       {"OFF 3 1 0 0\n", ": line 1: malformed OFF header: expected the counts"},
       {"OFF\n-3 1 0\n",
        ": line 2: malformed OFF header: the vertex count '-3' is not a non-negative integer"},

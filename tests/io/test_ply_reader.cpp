@@ -269,6 +269,13 @@ TEST(PlyReaderErrors, MalformedHeaders) {
       {"floatcount",
        ascii_header(kXyz, "element face 1\nproperty list float int vertex_indices\nend_header\n"),
        "list count type must be an integer type"},
+      {"dupprop", ascii_header(kXyz + "property float x\n", "end_header\n"),
+       "element 'vertex' declares property 'x' twice"},
+      {"dupelement", ascii_header(kXyz, kFaces + "element face 1\nproperty list uchar int vertex_indices\nend_header\n"),
+       "element 'face' declared twice"},
+      {"tristrips",
+       ascii_header(kXyz, "element tristrips 1\nproperty list int int vertex_indices\nend_header\n"),
+       "element 'tristrips' (triangle strips) is not supported"},
   };
   for (const Case& c : cases) {
     const auto file = dir.write(std::string(c.name) + ".ply", c.text);
@@ -300,6 +307,14 @@ TEST(PlyReaderErrors, AsciiDataProblems) {
   const auto idx = dir.write(
       "idx.ply", ascii_header(kXyz, kFaces + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2.0\n"));
   EXPECT_INPUT_ERROR(read_mesh_file(idx), idx.string() + ": line 13: expected an integer");
+  // A second face past the header's count: the counts do not describe the data. Trailing
+  // whitespace is fine.
+  const auto more = dir.write(
+      "more.ply", ascii_header(kXyz, kFaces + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 2 1 0\n"));
+  EXPECT_INPUT_ERROR(read_mesh_file(more), more.string() + ": line 14: '3' after the last element");
+  const auto space = dir.write(
+      "space.ply", ascii_header(kXyz, kFaces + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n\n  \n"));
+  EXPECT_EQ(read_mesh_file(space)[0].faces.size(), 1u);
 }
 
 TEST(PlyReaderErrors, IndicesOutOfRange) {
