@@ -8,7 +8,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -72,13 +74,11 @@ CLI::Validator tolerance() {
   return CLI::Validator(
       [](std::string& value) -> std::string {
         const std::string expect = "expected a finite number >= 0, got '" + value + "'";
-        try {
-          std::size_t used = 0;
-          const double v = std::stod(value, &used);
-          if (used != value.size() || !std::isfinite(v) || v < 0) return expect;
-        } catch (const std::exception&) {
-          return expect;
-        }
+        // strtod, not stod: stod throws on values that underflow to subnormals (1e-310).
+        if (value.empty() || std::isspace(static_cast<unsigned char>(value[0]))) return expect;
+        char* end = nullptr;
+        const double v = std::strtod(value.c_str(), &end);
+        if (end != value.c_str() + value.size() || !std::isfinite(v) || v < 0) return expect;
         return {};
       },
       ">= 0");

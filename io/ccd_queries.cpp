@@ -3,6 +3,7 @@
 #include "io/read_util.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <string>
 #include <string_view>
 
@@ -60,17 +61,31 @@ std::vector<CcdQuery> read_ccd_queries(const std::filesystem::path& file) {
     if (n != 7)
       fail(file, line, "expected 7 comma-separated integers (x_num,x_den,y_num,y_den,z_num,z_den,truth), found " +
                            std::to_string(n) + " fields");
-    double v[6];
+    // Numerators and denominators may have any number of digits: each is read in long
+    // double (range about 1e+-4932, so 10^400 / 10^400 is 1, not inf / inf), and the quotient
+    // is checked against the coordinate range there, before it is rounded to double (where
+    // 10^300 / 10^400 would underflow to 0).
+    long double v[6];
     for (int k = 0; k < 6; ++k) {
-      if (!is_integer_token(fields[k]) || !io_detail::parse_double(fields[k], v[k]))
+      if (!is_integer_token(fields[k]))
         fail(file, line, "field " + std::to_string(k + 1) + " '" + io_detail::abbreviate(fields[k]) + "' is not an integer");
+      const std::string digits(fields[k]);
+      v[k] = std::strtold(digits.c_str(), nullptr);
+      if (!std::isfinite(v[k]))
+        fail(file, line, "field " + std::to_string(k + 1) + " '" + io_detail::abbreviate(fields[k]) + "' is too large");
     }
     Vec3 p;
     for (int k = 0; k < 3; ++k) {
       if (v[2 * k + 1] == 0) fail(file, line, std::string("zero denominator for ") + io_detail::axis_name(k));
-      p[k] = v[2 * k] / v[2 * k + 1];
-      if (!std::isfinite(p[k]))
-        fail(file, line, std::string("coordinate ") + io_detail::axis_name(k) + " is not a finite double");
+      const long double q = v[2 * k] / v[2 * k + 1];
+      const long double m = std::fabs(q);
+      const std::string what = std::string("coordinate ") + io_detail::axis_name(k) + " = " +
+                               io_detail::abbreviate(fields[2 * k]) + "/" + io_detail::abbreviate(fields[2 * k + 1]);
+      if (m >= 0x1p200L)
+        fail(file, line, what + " is out of range (the supported range is |x| < 2^200, about 1.6e60)");
+      if (q != 0 && m < 0x1p-200L)
+        fail(file, line, what + " is too close to 0 (nonzero coordinates must be at least 2^-200, about 6.2e-61, in magnitude)");
+      p[k] = static_cast<double>(q);
     }
     // The kernel's guarantees hold for the coordinate range every reader enforces.
     if (const std::string problem = io_detail::coordinate_problem(p); !problem.empty())

@@ -363,6 +363,9 @@ TEST(Cli, RepeatedRunsAreIdenticalAndDiffDetectsChanges) {
   EXPECT_NE(r.output.find("distance"), std::string::npos) << r.output;
   r = vproxq("diff " + quote(a) + " " + quote(dir / "c.json") + " --rtol 1e-6");
   EXPECT_EQ(r.exit_code, 0) << r.output;
+  // A subnormal tolerance is a finite number >= 0 too (accepted, and far too small here).
+  r = vproxq("diff " + quote(a) + " " + quote(dir / "c.json") + " --atol=1e-310");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
   r = vproxq("diff " + quote(a) + " " + quote(dir / "missing.json"));
   EXPECT_EQ(r.exit_code, 3) << r.output;
   r = vproxq("diff " + quote(a) + " " + quote(dir.path()));  // the output folder, not its file

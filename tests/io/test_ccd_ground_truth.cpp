@@ -79,6 +79,21 @@ TEST(CcdQueryReader, ReadsRationalsExactly) {
   EXPECT_EQ(qs[0].line, 1);
 }
 
+TEST(CcdQueryReader, NumeratorsAndDenominatorsOfAnyLength) {
+  // Quotients are formed before rounding to double: 10^400 / 10^400 is 1 (not inf / inf), and
+  // 10^300 / 10^350 is 1e-50 (not 0).
+  const std::string e400 = "1" + std::string(400, '0'), e350 = "1" + std::string(350, '0'),
+                    e300 = "1" + std::string(300, '0');
+  test::TempDir dir;
+  std::string rows;
+  for (int i = 0; i < 8; ++i) rows += e400 + "," + e400 + "," + e300 + "," + e350 + ",-" + e300 + ",1" + std::string(250, '0') + ",0\n";
+  const std::vector<CcdQuery> qs = read_ccd_queries(dir.write("q.csv", rows));
+  ASSERT_EQ(qs.size(), 1u);
+  EXPECT_EQ(qs[0].start[0].x(), 1.0);
+  EXPECT_NEAR(qs[0].start[0].y(), 1e-50, 1e-64);
+  EXPECT_NEAR(qs[0].end[3].z(), -1e50, 1e36);
+}
+
 void expect_input_error(const std::string& text, const std::string& needle) {
   test::TempDir dir;
   const fs::path f = dir.write("bad.csv", text);
@@ -93,6 +108,11 @@ TEST(CcdQueryReader, RejectsMalformedFiles) {
   expect_input_error("0,1,0,1,0,1\n", "line 1: expected 7");
   expect_input_error(ok_row + "0,1,x,1,0,1,0\n", "line 2: field 3");
   expect_input_error(ok_row + ok_row + "0,0,0,1,0,1,0\n", "line 3: zero denominator");
+  // Below 2^-200 (1e-400, which a double would round to 0) and at or above 2^200.
+  expect_input_error(ok_row + "0,1,1,1" + std::string(400, '0') + ",0,1,0\n", "line 2: coordinate y = 1/1000");
+  expect_input_error(ok_row + "0,1,1," + std::string("1") + std::string(100, '0') + ",0,1,0\n", "too close to 0");
+  expect_input_error(ok_row + "1" + std::string(61, '0') + ",1,0,1,0,1,0\n", "line 2: coordinate x = 1000");
+  expect_input_error(ok_row + "1" + std::string(5000, '0') + ",1,0,1,0,1,0\n", "line 2: field 1");
   expect_input_error("0,1,0,1,0,1,2\n", "line 1: truth");
   expect_input_error(ok_row + "0,1,0,1,0,1,1\n", "line 2: truth differs");
   EXPECT_THROW(read_ccd_queries(kQueryDir / "no-such-file.csv"), InputError);

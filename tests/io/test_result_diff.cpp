@@ -162,6 +162,29 @@ TEST_F(DiffTest, IntegersAndFloatsCompareAsNumbers) {
   EXPECT_TRUE(diff(base_document(), b).equal);
 }
 
+TEST_F(DiffTest, IntegersAreComparedExactlyWhateverTheTolerance) {
+  // Ids, counts and frame numbers are answers: a tolerance meant for distances must not let
+  // triangle 1000001 pass for 1000000, and integers beyond 2^53 must not merge in a double.
+  DiffOptions loose;
+  loose.rtol = 1e-3;
+  loose.atol = 1;
+  Json b = base_document();
+  b["frames"][0]["distance"]["inter"][0]["triangles"][0] =
+      b["frames"][0]["distance"]["inter"][0]["triangles"][0].get<std::int64_t>() + 1;
+  const DiffOutcome d = diff(base_document(), b, loose);
+  EXPECT_FALSE(d.equal);
+  EXPECT_NE(d.first_difference.find("triangles[0]"), std::string::npos) << d.first_difference;
+  Json big_a = base_document(), big_b = base_document();
+  big_a["frames"][0]["objects"][0]["vertices"] = std::uint64_t{1} << 53;
+  big_b["frames"][0]["objects"][0]["vertices"] = (std::uint64_t{1} << 53) + 1;
+  EXPECT_FALSE(diff(big_a, big_b).equal);
+  // Doubles within the tolerance still pass.
+  Json c = base_document();
+  c["frames"][0]["distance"]["inter"][0]["distance"] =
+      c["frames"][0]["distance"]["inter"][0]["distance"].get<double>() + 0.5;
+  EXPECT_TRUE(diff(base_document(), c, loose).equal);
+}
+
 TEST_F(DiffTest, NullVersusNumberDiffers) {
   Json b = base_document();
   b["frames"][2]["distance"]["inter"][0]["distance"] = 1.5;
