@@ -223,6 +223,12 @@ int cli_main(int argc, char** argv) {
   if (done) return code;
   return guarded([&] {
     if (!frames.empty()) config.frames = parse_frame_range(frames);
+    // Options that the chosen backend does not use: said once, so that a sweep over --grid
+    // with the default --voronoi=off does not silently measure the same run again and again.
+    if (!config.quiet && config.voronoi == "off" && config.grid > 0)
+      std::fprintf(stderr, "vproxq: note: --grid has no effect with --voronoi=off\n");
+    if (!config.quiet && config.device >= 0 && (config.voronoi == "off" || config.voronoi == "cpu"))
+      std::fprintf(stderr, "vproxq: note: --device has no effect with --voronoi=%s\n", config.voronoi.c_str());
     run(config);
     return exit_code::kOk;
   });

@@ -195,7 +195,7 @@ void run(const Config& config) {
   const long last = std::min(config.frames.last.value_or(count), count);
   if (first >= count)
     throw UsageError("--frames: first frame " + std::to_string(first) + " is past the end (" +
-                     config.scene_path + " has " + std::to_string(count) + " frames)");
+                     config.scene_path + " has " + std::to_string(count) + (count == 1 ? " frame)" : " frames)"));
 
   RunInfo info;
   info.scene = config.scene_path;
@@ -306,8 +306,9 @@ void run(const Config& config) {
   if (writer) {
     writer->commit();
     if (!config.quiet)
-      std::fprintf(stderr, "vproxq: wrote %s/results.json and %s/results.h5 (%zu frames)\n",
-                   config.output_dir.c_str(), config.output_dir.c_str(), info.frame_count);
+      std::fprintf(stderr, "vproxq: wrote %s/results.json and %s/results.h5 (%zu frame%s)\n",
+                   config.output_dir.c_str(), config.output_dir.c_str(), info.frame_count,
+                   info.frame_count == 1 ? "" : "s");
   }
 }
 

@@ -396,6 +396,7 @@ void parse_scene_json(SceneImpl& s) {
   if (root.contains("queries")) {
     const json& q = root["queries"];
     if (!q.is_array()) p.fail("queries", "must be an array of query names, got " + shown(q));
+    if (q.empty()) p.fail("queries", "is empty: list at least one query, or leave the key out (default: distance)");
     for (std::size_t i = 0; i < q.size(); ++i) {
       const std::string key = "queries[" + std::to_string(i) + "]";
       const std::string name = p.string(q[i], key);

@@ -71,6 +71,19 @@ TEST(Cli, HelpAndVersion) {
   EXPECT_EQ(r.exit_code, 0);
 }
 
+TEST(Cli, OptionsTheBackendDoesNotUseAreNoted) {
+  const std::string scene = quote(kSamples / "two-cubes" / "scene.json");
+  auto r = vproxq(scene + " --grid 64 --device 0");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("note: --grid has no effect with --voronoi=off"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("note: --device has no effect with --voronoi=off"), std::string::npos) << r.output;
+  r = vproxq(scene + " --grid 64 --voronoi=cpu");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("note:"), std::string::npos) << r.output;
+  r = vproxq(scene + " --grid 64 --quiet");
+  EXPECT_EQ(r.output.find("note:"), std::string::npos) << r.output;
+}
+
 TEST(Cli, UsageErrors) {
   const std::string scene = quote(kSamples / "two-cubes" / "scene.json");
   auto r = vproxq(scene + " --queries=distance,bogus");

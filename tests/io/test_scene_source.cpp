@@ -374,6 +374,8 @@ TEST_F(SceneSourceTest, EveryBadKeyIsReported) {
        {"\"queries\" must be an array"}},
       {R"({"frames": {"files": ["a_0.obj"]}, "queries": ["distanse"]})",
        {"\"queries[0]\" must be one of \"distance\", \"ccd\", \"pd\", got \"distanse\""}},
+      {R"({"frames": {"files": ["a_0.obj"]}, "queries": []})",
+       {"\"queries\" is empty"}},
       {R"({"frames": {"files": ["a_0.obj"]}, "queries": ["ccd", "pd", "ccd"]})",
        {"\"queries[2]\" lists \"ccd\" a second time"}},
       {R"({"frames": {"files": ["a_0.obj"]}, "grid": 0})",
