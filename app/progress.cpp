@@ -17,6 +17,13 @@ void Progress::update(std::size_t done) {
   dirty_ = true;
 }
 
+void Progress::clear() {
+  if (!active_ || !dirty_) return;
+  std::fprintf(stderr, "\r%*s\r", 60, "");
+  std::fflush(stderr);
+  dirty_ = false;
+}
+
 void Progress::finish() {
   if (active_ && dirty_) std::fprintf(stderr, "\n");
   dirty_ = false;

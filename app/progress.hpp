@@ -11,6 +11,8 @@ class Progress {
   /// Shows nothing unless `enabled`, stderr is a terminal and there is more than one frame.
   Progress(std::size_t total, bool enabled);
   void update(std::size_t done);
+  /// Erases the progress line (before other output to the terminal); update() redraws it.
+  void clear();
   void finish();
 
  private:

@@ -296,7 +296,8 @@ void run(const Config& config) {
       // write_frame() fills in and adds its own time before serialising the stats.
       writer->write_frame(result);
     } else if (!config.quiet) {
-      progress.finish();
+      progress.clear();
+      std::fflush(stdout);
       print_summary(result);
       print_intra_summary(result);
     }
