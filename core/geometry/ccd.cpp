@@ -328,6 +328,17 @@ CcdResult edge_edge_ccd(const std::array<Vec3, 4>& start, const std::array<Vec3,
   return solve(Kind::EdgeEdge, start, end);
 }
 
+double ccd_share_factor() { return 1 / (1 - 2 * kCcdRelativeTolerance); }
+
+double ccd_tolerance_share(double extent, double magnitude) {
+  // ccd_max_tolerance(S, m) <= (a S + 8 eps(m)) (1 + 2^-40) with a = kCcdRelativeTolerance (a
+  // max is below the sum), and eps(max(x, y)) <= eps(x) + eps(y). With S <= sA + sB + M:
+  // M (1 - a (1 + 2^-40)) <= the terms of A + those of B; dividing by 1 - 2a instead of
+  // 1 - a (1 + 2^-40) leaves room for the rounding of these few operations.
+  const double eps = magnitude * kEpsilonFactor + kUnderflowSlack;
+  return (kCcdRelativeTolerance * extent + kDeltaOverEpsilon * eps) * (1 + 0x1p-40) * ccd_share_factor();
+}
+
 double ccd_max_tolerance(double extent, double magnitude) {
   const double eps = magnitude * kEpsilonFactor + kUnderflowSlack;
   // The widening by 2^-40 absorbs the rounding of these few operations (they are monotone,

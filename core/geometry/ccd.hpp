@@ -66,4 +66,15 @@ CcdResult edge_edge_ccd(const std::array<Vec3, 4>& start, const std::array<Vec3,
 /// it so that culling never removes a pair the kernel would report within δ.
 double ccd_max_tolerance(double extent, double magnitude);
 
+/// A share of ccd_max_tolerance() per point set, for culling by widened boxes: for two point
+/// sets A and B (largest box sides sA, sB, coordinates bounded by mA, mB) whose boxes are at
+/// most M apart along every axis, where M = ccd_max_tolerance(extent of A and B together,
+/// max(mA, mB)) + R(max(mA, mB)) and R is a rounding slack that grows at most linearly with
+/// the magnitude (R(max(x, y)) <= R(x) + R(y)): M <= ccd_tolerance_share(sA, mA) +
+/// R(mA) * ccd_share_factor() + (the same for B). The extent of both together is at most
+/// sA + sB + M; solving for M gives the factor.
+double ccd_tolerance_share(double extent, double magnitude);
+/// 1 / (1 - 2 kCcdRelativeTolerance): see ccd_tolerance_share().
+double ccd_share_factor();
+
 }  // namespace vproxq

@@ -375,6 +375,9 @@ CcdSweep CcdSweep::compute(const Frame& from, const Frame& to, int threads) {
   }
   const double extent = all.empty() ? 0.0 : (all.hi - all.lo).maxCoeff();
   s.margin = ccd_max_tolerance(extent, magnitude) + rounding_slack(magnitude);
+  s.raw_objects.assign(n, AABB{});
+  s.magnitudes.assign(n, 0.0);
+  s.widening.assign(n, 0.0);
   const auto& ids = s.participants.objects;
   parallel_for(ids.size(), threads, [&](size_t k) {
     const size_t i = static_cast<size_t>(ids[k]);
@@ -382,7 +385,18 @@ CcdSweep CcdSweep::compute(const Frame& from, const Frame& to, int threads) {
     const Object& b = to.objects[i];
     auto& vb = s.vertices[i];
     vb.resize(a.positions.size());
-    for (size_t v = 0; v < vb.size(); ++v) vb[v] = swept_box(a, b, {static_cast<Index>(v)});
+    AABB raw;
+    for (size_t v = 0; v < vb.size(); ++v) {
+      vb[v] = swept_box(a, b, {static_cast<Index>(v)});
+      raw.extend(vb[v]);
+    }
+    s.raw_objects[i] = raw;
+    if (!raw.empty()) {
+      s.magnitudes[i] = std::max(raw.lo.cwiseAbs().maxCoeff(), raw.hi.cwiseAbs().maxCoeff());
+      s.widening[i] = ccd_tolerance_share((raw.hi - raw.lo).maxCoeff(), s.magnitudes[i]) +
+                      rounding_slack(s.magnitudes[i]) * ccd_share_factor();
+    }
+    const double w = s.widening[i];
     auto& tb = s.triangles[i];
     tb.resize(static_cast<size_t>(a.num_triangles()));
     AABB box;
@@ -391,14 +405,22 @@ CcdSweep CcdSweep::compute(const Frame& from, const Frame& to, int threads) {
       AABB tri = vb[static_cast<size_t>(f[0])];
       tri.extend(vb[static_cast<size_t>(f[1])]);
       tri.extend(vb[static_cast<size_t>(f[2])]);
-      tri.lo.array() -= s.margin;
-      tri.hi.array() += s.margin;
+      tri.lo.array() -= w;
+      tri.hi.array() += w;
       tb[static_cast<size_t>(t)] = tri;
       box.extend(tri);
     }
     s.objects[i] = box;
   });
   return s;
+}
+
+double CcdSweep::pair_margin(Index i, Index j) const {
+  AABB both = raw_objects[static_cast<size_t>(i)];
+  both.extend(raw_objects[static_cast<size_t>(j)]);
+  const double extent = both.empty() ? 0.0 : (both.hi - both.lo).maxCoeff();
+  const double magnitude = std::max(magnitudes[static_cast<size_t>(i)], magnitudes[static_cast<size_t>(j)]);
+  return ccd_max_tolerance(extent, magnitude) + rounding_slack(magnitude);
 }
 
 CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const CcdOptions& opts) {
@@ -467,7 +489,6 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
     const Ownership& own_i = owners[static_cast<size_t>(i)];
     const Ownership& own_j = owners[static_cast<size_t>(j)];
     const auto& tb_i = sweep.triangles[static_cast<size_t>(i)];
-    const auto& tb_j = sweep.triangles[static_cast<size_t>(j)];
     const auto& vb_i = sweep.vertices[static_cast<size_t>(i)];
     const auto& vb_j = sweep.vertices[static_cast<size_t>(j)];
     const auto& swept_i = swept[static_cast<size_t>(i)];
@@ -481,19 +502,30 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
       box.extend(vb[static_cast<size_t>(e[1])]);
       return box;
     };
+    // A triangle's swept box, not widened.
+    auto raw_box = [](const std::vector<AABB>& vb, const Face& f) {
+      AABB box = vb[static_cast<size_t>(f[0])];
+      box.extend(vb[static_cast<size_t>(f[1])]);
+      box.extend(vb[static_cast<size_t>(f[2])]);
+      return box;
+    };
     const AABB& box_j = sweep.objects[static_cast<size_t>(j)];
     const bool self = i == j;
     Hits& hits = parts[k];
     // Separation that rules out a report: the kernel reports a pair whose primitives come
     // within δ_k on every axis (at most sqrt(3) δmax apart), and margin >= δmax + slack.
-    const double apart_gap = 2 * sweep.margin;
+    const double margin = sweep.pair_margin(i, j);
+    const double apart_gap = 2 * margin;
 
     // Vertex v of object ov (owned by tri fv) against face g of object og.
     auto vertex_face = [&](Index ov, const std::vector<AABB>& v_boxes, Index v, Index og,
-                           const Face& g_face, Index g, const AABB& g_box, const SweptTriangle& g_swept) {
+                           const Face& g_face, Index g, const AABB& g_raw, const SweptTriangle& g_swept) {
       if (self && in_face(v, g_face)) return;
-      // The vertex's own swept box against the face's widened one: exact comparisons.
-      if (!boxes_overlap(v_boxes[static_cast<size_t>(v)], g_box)) return;
+      // The vertex's own swept box, widened by the pair's margin, against the face's.
+      AABB vbox = v_boxes[static_cast<size_t>(v)];
+      vbox.lo.array() -= margin;
+      vbox.hi.array() += margin;
+      if (!boxes_overlap(vbox, g_raw)) return;
       const SweptPrimitives<1, 3> p{{from.objects[static_cast<size_t>(ov)].positions[static_cast<size_t>(v)]},
                                     {to.objects[static_cast<size_t>(ov)].positions[static_cast<size_t>(v)]},
                                     g_swept.start, g_swept.end};
@@ -512,6 +544,7 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
         continue;
       }
       const Face& ff = oi.topology->faces[static_cast<size_t>(f)];
+      const AABB f_raw = raw_box(vb_i, ff);
       const SweptTriangle& swept_f = swept_i[static_cast<size_t>(f)];
       const AABB& f_start = ends_i.start[static_cast<size_t>(f)];
       const AABB& f_end = ends_i.end[static_cast<size_t>(f)];
@@ -531,14 +564,14 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
           ++hits.counters.separated_pairs;
           return;
         }
-        const AABB& gb = tb_j[static_cast<size_t>(g)];
+        const AABB g_raw = raw_box(vb_j, gf);
         const SweptTriangle& swept_g = swept_j[static_cast<size_t>(g)];
         for (size_t k = 0; k < 3; ++k)
           if (own_i.vertex[static_cast<size_t>(ff[k])] == f && !repeats_earlier(ff, k))
-            vertex_face(i, vb_i, ff[k], j, gf, g, gb, swept_g);
+            vertex_face(i, vb_i, ff[k], j, gf, g, g_raw, swept_g);
         for (size_t k = 0; k < 3; ++k)
           if (own_j.vertex[static_cast<size_t>(gf[k])] == g && !repeats_earlier(gf, k))
-            vertex_face(j, vb_j, gf[k], i, ff, f, fb, swept_f);
+            vertex_face(j, vb_j, gf[k], i, ff, f, f_raw, swept_f);
         const auto& fe = adj_i.triangle_edges(f);
         const auto& ge = adj_j.triangle_edges(g);
         for (size_t ka = 0; ka < 3; ++ka) {
@@ -552,8 +585,8 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
             const auto& vb = adj_j.edges()[static_cast<size_t>(eb)];
             if (self && share_endpoint(va, vb)) continue;
             AABB bb = edge_box(vb_j, vb);
-            bb.lo.array() -= sweep.margin;
-            bb.hi.array() += sweep.margin;
+            bb.lo.array() -= margin;
+            bb.hi.array() += margin;
             if (!boxes_overlap(ba, bb)) continue;
             auto ends = [](const Object& o, const std::array<Index, 2>& e) {
               return std::array<Vec3, 2>{o.positions[static_cast<size_t>(e[0])], o.positions[static_cast<size_t>(e[1])]};

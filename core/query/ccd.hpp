@@ -21,10 +21,12 @@
 // of one object sharing a vertex. Vertices used by no face take no part.
 //
 // Culling margin: the kernel may report a pair whose primitives come within its tolerance δ
-// (never more than ccd_max_tolerance() for this step's coordinates); all boxes are widened by
-// that plus rounding_slack() (the separating-axis tests ask for twice that, as the kernel's
-// per-axis δ allows a Euclidean gap of sqrt(3) δ), so culling never removes a pair the kernel
-// would report and the results equal the brute force — with one documented exception: a
+// (never more than ccd_max_tolerance() for the coordinates of the two objects involved); each
+// pair of objects gets that plus rounding_slack() as its margin (CcdSweep::pair_margin(); the
+// primitive box tests widen by it, the separating-axis tests ask for twice that, as the
+// kernel's per-axis δ allows a Euclidean gap of sqrt(3) δ), triangle boxes are widened by a
+// per-object share of it (ccd_tolerance_share()), and Stage II by the step's largest margin,
+// so culling never removes a pair the kernel would report and the results equal the brute force — with one documented exception: a
 // test that stops at the kernel's box limit (counters.limit_hits) is reported without a
 // proximity guarantee, so brute force could report such a pair where culling (correctly: it
 // cannot collide) removed it.
@@ -64,9 +66,23 @@ std::optional<Frame> ccd_counterparts_by_name(const Frame& from, const Frame& to
 /// Swept geometry of a step shared by Stage I, II and III.
 struct CcdSweep {
   CcdParticipants participants;
-  /// Culling margin (see above) added on every side of every swept box.
+  /// Culling margin of the whole step (see above): at least the margin of any pair of its
+  /// objects (pair_margin()). Stage II widens its prisms by it.
   double margin = 0;
-  /// [object][triangle] swept boxes (widened), empty for skipped objects.
+  /// Per object: its swept box (both frames, all vertices; not widened), the largest
+  /// coordinate magnitude in it, and how much its triangle boxes are widened
+  /// (ccd_tolerance_share(), so that two objects' widenings add up to at least their
+  /// pair_margin() wherever their boxes come that close).
+  std::vector<AABB> raw_objects;
+  std::vector<double> magnitudes;
+  std::vector<double> widening;
+  /// The culling margin of a pair of objects: ccd_max_tolerance() for the coordinates of the
+  /// two objects (the kernel's δ of any query made of their primitives is at most that) plus
+  /// rounding_slack() of their magnitude. One far-away object then does not widen the
+  /// margins of the others.
+  double pair_margin(Index i, Index j) const;
+  /// [object][triangle] swept boxes (widened by the object's `widening`), empty for skipped
+  /// objects.
   std::vector<std::vector<AABB>> triangles;
   std::vector<AABB> objects;  ///< union of an object's swept triangle boxes
   /// [object][vertex] the segment from the vertex's start to its end position, boxed (not

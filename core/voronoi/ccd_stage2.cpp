@@ -205,7 +205,15 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
   AABB scene;
   for (size_t i = 0; i < n; ++i) {
     first_[i + 1] = first_[i] + (part[i] ? from.objects[i].num_triangles() : 0);
-    if (part[i] && !sweep.objects[i].empty()) scene.extend(sweep.objects[i]);
+    if (part[i] && !sweep.objects[i].empty()) {
+      // The object's triangle boxes are widened by its own share of the margin; the prisms
+      // below by the step's whole margin: the grid covers the larger.
+      AABB box = sweep.objects[i];
+      const double more = i < sweep.widening.size() ? std::max(0.0, sweep.margin - sweep.widening[i]) : 0.0;
+      box.lo.array() -= more;
+      box.hi.array() += more;
+      scene.extend(box);
+    }
   }
   const std::int64_t total_tris = first_[n];
   offsets_.assign(1, 0);

@@ -4,6 +4,7 @@
 // collide at a known time (the reported TOI must not exceed it) or to stay apart.
 #include <gtest/gtest.h>
 
+#include "core/broad_phase/object_broad_phase.hpp"
 #include "core/geometry/ccd.hpp"
 #include "support/random_scene.hpp"
 
@@ -309,6 +310,38 @@ TEST(CcdKernel, RandomSeparatedQueries) {
       ASSERT_FALSE(edge_edge_ccd(s, e).collides) << q;
     }
   }
+}
+
+TEST(CcdKernel, SharesOfTwoPointSetsCoverTheirPairsTolerance) {
+  // For boxes A and B at most M apart, M = ccd_max_tolerance(extent of both, max magnitude) +
+  // rounding_slack(max magnitude): each box widened by its own share covers M.
+  test::Rng rng(41);
+  int close = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const double scale = std::pow(10.0, rng.uniform(-8, 8));
+    const double offset = std::pow(10.0, rng.uniform(-8, 12)) * (rng.uniform(0, 1) < 0.5 ? -1 : 1);
+    auto box = [&](AABB& b) {
+      const Vec3 lo = Vec3::Constant(offset) + scale * Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+      b.lo = lo;
+      b.hi = lo + scale * rng.uniform(0, 1) * Vec3(rng.uniform(0, 1), rng.uniform(0, 1), rng.uniform(0, 1));
+    };
+    AABB a, b;
+    box(a);
+    box(b);
+    auto magnitude = [](const AABB& x) { return std::max(x.lo.cwiseAbs().maxCoeff(), x.hi.cwiseAbs().maxCoeff()); };
+    AABB both = a;
+    both.extend(b);
+    const double m = std::max(magnitude(a), magnitude(b));
+    const double pair = ccd_max_tolerance((both.hi - both.lo).maxCoeff(), m) + rounding_slack(m);
+    const double gap = (a.lo - b.hi).cwiseMax(b.lo - a.hi).maxCoeff();
+    if (gap > pair) continue;  // the pair's own margin already culls them
+    ++close;
+    auto share = [&](const AABB& x) {
+      return ccd_tolerance_share((x.hi - x.lo).maxCoeff(), magnitude(x)) + rounding_slack(magnitude(x)) * ccd_share_factor();
+    };
+    ASSERT_GE(share(a) + share(b), pair) << "scale " << scale << " offset " << offset;
+  }
+  EXPECT_GT(close, 1000);
 }
 
 }  // namespace

@@ -90,6 +90,39 @@ TEST(CcdPipeline, LargeCoordinateOffsetEqualsBruteForce) {
   expect_same_ccd(continuous_collisions(from, to, sweep, CcdOptions{2, &voxels}), ref);
 }
 
+TEST(CcdPipeline, AFarAwayObjectLeavesTheOthersMarginsAsTheyWere) {
+  // Culling margins are per object pair (the kernel's δ depends on the query's own points):
+  // an object parked a million units away must not widen the margins of the objects near the
+  // origin. With one step-wide margin (1e-6 of the step's extent, here about 1) every
+  // neighbouring triangle pair of the cluster was tested.
+  const Frame cluster_from = test::make_random_frame(31, 4, 2.5, 1);
+  const Frame cluster_to = moved(cluster_from, 32, 0.5, 0.2);
+  Frame from = cluster_from, to = cluster_to;
+  test::Rng rng(33);
+  Object far = test::make_blob(rng, Vec3(1e6, 1e6, 1e6), 1.0, 1, 0.2, "far");
+  from.objects.push_back(far);
+  to.objects.push_back(far);
+  const CcdStepResult ref = continuous_collisions_brute_force(from, to);
+  EXPECT_GT(ref.vf.size() + ref.ee.size(), 0u);
+  const CcdStepResult got = continuous_collisions(from, to, CcdOptions{2, nullptr});
+  expect_same_ccd(got, ref);
+  const CcdStepResult alone = continuous_collisions(cluster_from, cluster_to, CcdOptions{2, nullptr});
+  EXPECT_EQ(got.counters.elementary_tests(), alone.counters.elementary_tests());
+  Frame far_from, far_to;
+  far_from.objects = {far};
+  far_to.objects = {far};
+  far_to.index = 1;
+  const CcdStepResult far_alone = continuous_collisions(far_from, far_to, CcdOptions{2, nullptr});
+  EXPECT_EQ(got.counters.triangle_pairs, alone.counters.triangle_pairs + far_alone.counters.triangle_pairs);
+  const CcdSweep sweep = CcdSweep::compute(from, to, 2);
+  EXPECT_GT(sweep.margin, 1.0);                // the step's: its extent is 1.7e6
+  EXPECT_LT(sweep.pair_margin(0, 1), 1e-4);   // two objects of the cluster
+  EXPECT_GT(sweep.pair_margin(0, 4), 1.0);    // with the far one
+  // Stage II keeps using the step's margin; the answers stay the same.
+  const CcdVoxelCulling voxels(from, to, sweep, 32, 2);
+  expect_same_ccd(continuous_collisions(from, to, sweep, CcdOptions{2, &voxels}), ref);
+}
+
 TEST(CcdPipeline, TopologyChangeAndMissingObjectAreSkipped) {
   Frame from = test::make_random_frame(3, 3, 2.0, 1);
   Frame to = moved(from, 4, 0.5, 0.1);
@@ -276,7 +309,7 @@ TEST(CcdPipeline, NearMissesWithinTheKernelToleranceAreKept) {
   // primitives never touch: a culling direction in the floor's plane across the hypotenuse
   // (which none of the separating-axis tests uses) would, unless it asked for a gap above the
   // culling margin.
-  for (const double fraction : {0.05, 0.2}) {
+  for (const double fraction : {0.05, 0.2, 0.9}) {
     SCOPED_TRACE("h = " + std::to_string(fraction) + " δ");
     auto floor_topo = std::make_shared<Topology>();
     floor_topo->num_vertices = 3;
