@@ -91,6 +91,7 @@ FrameBoxes FrameBoxes::compute(const Frame& frame, int threads) {
     if (!box.empty()) mags[i] = std::max(box.lo.cwiseAbs().maxCoeff(), box.hi.cwiseAbs().maxCoeff());
   });
   for (double m : mags) fb.magnitude = std::max(fb.magnitude, m);
+  fb.magnitudes = std::move(mags);
   fb.bvh_cache = std::make_shared<BvhCache>(n);
   return fb;
 }

@@ -27,6 +27,7 @@ struct FrameBoxes {
   std::vector<std::vector<AABB>> triangles;  ///< [object][triangle]
   std::vector<AABB> objects;                 ///< empty box for an object without triangles
   double magnitude = 0;                      ///< largest |coordinate| of any triangle corner
+  std::vector<double> magnitudes;            ///< the same per object (0 without triangles)
 
   static FrameBoxes compute(const Frame& frame, int threads);
 

@@ -178,7 +178,6 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
   Stopwatch sw;
   IntraDistanceOutput out;
   const int threads = std::max(1, opts.threads);
-  const double slack = rounding_slack(boxes.magnitude);
   const size_t n_obj = frame.objects.size();
   out.per_object.resize(n_obj);
   for (size_t i = 0; i < n_obj; ++i) {
@@ -202,6 +201,9 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     const auto [object, block] = blocks.locate(item);
     const size_t i = object;  // a plain variable: lambdas below capture it
     const Object& o = frame.objects[i];
+    // Every distance compared here is between two triangles of object i: its own magnitude
+    // bounds their rounding (an object far away elsewhere in the scene does not matter).
+    const double slack = rounding_slack(boxes.magnitudes[i]);
     IntraObjectDistance& res = out.per_object[i];
     const size_t n = res.per_triangle.size();
     const auto& tboxes = boxes.triangles[i];

@@ -145,6 +145,22 @@ TEST(IntraDistance, Ring2BoundSkipsHubsAndStaysAnUpperBound) {
   expect_same_intra(intra_object_distance(frame, {2}), ref, "cylinder with fan caps");
 }
 
+TEST(IntraDistance, AFarAwayObjectDoesNotWidenTheOthersSearch) {
+  // The rounding slack of an object's search comes from its own coordinates: a blob parked at
+  // 1e12 (whose slack is 100 units) must not turn the sheet's search into all pairs.
+  Rng rng(5);
+  const Object sheet = test::make_folded_sheet(rng, 16, 6, 0.1, 0.05, 0.1);
+  const Frame alone = frame_of({sheet});
+  const Frame with_far = frame_of({sheet, test::make_blob(rng, Vec3::Constant(1e12), 1.0, 1, 0.2, "far")});
+  const auto ref = intra_object_distance_brute_force(with_far);
+  const auto got = intra_object_distance(with_far, {2});
+  expect_same_intra(got, ref, "sheet and a far blob");
+  const auto sheet_only = intra_object_distance(alone, {1});
+  const auto both = intra_object_distance(with_far, {1});
+  const auto blob_only = intra_object_distance(frame_of({with_far.objects[1]}), {1});
+  EXPECT_EQ(both.counters.intra_candidates, sheet_only.counters.intra_candidates + blob_only.counters.intra_candidates);
+}
+
 TEST(IntraDistance, IrregularMeshExclusionsAreByVertexSharing) {
   Rng rng(7);
   const Frame frame = frame_of({test::make_irregular_mesh(rng)});
