@@ -94,6 +94,10 @@ int report(const char* kind, const std::exception& e, int code) {
 }
 
 /// Runs `body`, mapping the error kinds to their exit codes.
+/// Said after "out of memory" (set by the main command: a coarser --grid helps only when a
+/// Voronoi backend runs).
+const char* g_out_of_memory_hint = "";
+
 template <typename F>
 int guarded(F&& body) {
   try {
@@ -105,9 +109,7 @@ int guarded(F&& body) {
   } catch (const RuntimeError& e) {
     return report("error", e, exit_code::kRuntime);
   } catch (const std::bad_alloc&) {
-    std::fprintf(stderr,
-                 "vproxq: error: out of memory (std::bad_alloc); with --voronoi=cpu or gpu a coarser "
-                 "--grid needs less\n");
+    std::fprintf(stderr, "vproxq: error: out of memory (std::bad_alloc)%s\n", g_out_of_memory_hint);
     return exit_code::kRuntime;
   } catch (const std::exception& e) {
     return report("error", e, exit_code::kRuntime);
@@ -223,6 +225,7 @@ int cli_main(int argc, char** argv) {
   if (done) return code;
   return guarded([&] {
     if (!frames.empty()) config.frames = parse_frame_range(frames);
+    g_out_of_memory_hint = config.voronoi == "off" ? "" : "; a coarser --grid (or --voronoi=off) needs less";
     // Options that the chosen backend does not use: said once, so that a sweep over --grid
     // with the default --voronoi=off does not silently measure the same run again and again.
     if (!config.quiet && config.voronoi == "off" && config.grid > 0)
