@@ -1,5 +1,7 @@
 #include "core/mesh/adjacency.hpp"
 
+#include "core/parallel.hpp"
+
 #include <algorithm>
 #include <utility>
 
@@ -86,41 +88,73 @@ std::vector<Index> Adjacency::ring2(Index t) const {
   return row;
 }
 
-IndexSpan Adjacency::ring2_vertices(Index t) const {
+void Adjacency::prepare_ring2_vertices(int threads) const {
   std::call_once(ring2_vertices_once_, [&] {
-    IndexRows rows;
-    rows.offsets.assign(faces_.size() + 1, 0);
+    const std::size_t nt = faces_.size(), nv = vertex_tris_.rows();
     auto walked = [&](Index v) { return vertex_triangles(v).size() <= kRingWalkValence; };
-    std::vector<Index> outer, tris, verts;  // scratch, reused per triangle
-    for (std::size_t u = 0; u < faces_.size(); ++u) {
-      const Face& f = faces_[u];
-      auto own = [&](Index v) { return v == f[0] || v == f[1] || v == f[2]; };
-      // The 1-ring's vertices other than f's own, through f's walked vertices; their
-      // triangles that share no vertex with f (2-ring triangles); those triangles' vertices.
-      outer.clear();
-      for (Index v : f)
-        if (walked(v))
-          for (Index g : vertex_triangles(v))
-            for (Index w : faces_[static_cast<std::size_t>(g)])
-              if (!own(w) && walked(w)) outer.push_back(w);
-      std::sort(outer.begin(), outer.end());
-      outer.erase(std::unique(outer.begin(), outer.end()), outer.end());
-      tris.clear();
-      for (Index w : outer)
-        for (Index h : vertex_triangles(w))
-          if (!share_vertex(f, faces_[static_cast<std::size_t>(h)])) tris.push_back(h);
-      std::sort(tris.begin(), tris.end());
-      tris.erase(std::unique(tris.begin(), tris.end()), tris.end());
-      verts.clear();
-      for (Index h : tris)
-        for (Index b : faces_[static_cast<std::size_t>(h)]) verts.push_back(b);
-      std::sort(verts.begin(), verts.end());
-      verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
-      rows.values.insert(rows.values.end(), verts.begin(), verts.end());
-      rows.offsets[u + 1] = static_cast<Index>(rows.values.size());
+    // Rows per block of triangles, in parallel, then concatenated in triangle order. A few
+    // blocks per thread: each block clears marks over all vertices and triangles.
+    const std::size_t kRowsPerBlock =
+        std::max<std::size_t>(1024, (nt + 4 * static_cast<std::size_t>(std::max(threads, 1)) - 1) /
+                                        (4 * static_cast<std::size_t>(std::max(threads, 1))));
+    const std::size_t blocks = (nt + kRowsPerBlock - 1) / kRowsPerBlock;
+    std::vector<std::vector<Index>> values(blocks);
+    std::vector<std::vector<Index>> counts(blocks);
+    parallel_for(blocks, threads, [&](std::size_t blk) {
+      // Marks instead of sorting: entry == stamp means seen for the current triangle.
+      std::vector<std::uint32_t> outer_mark(nv, 0), vert_mark(nv, 0), tri_mark(nt, 0);
+      std::uint32_t stamp = 0;
+      std::vector<Index> outer, verts;
+      for (std::size_t u = blk * kRowsPerBlock; u < std::min(nt, (blk + 1) * kRowsPerBlock); ++u) {
+        ++stamp;
+        const Face& f = faces_[u];
+        auto own = [&](Index v) { return v == f[0] || v == f[1] || v == f[2]; };
+        // The 1-ring's vertices other than f's own, through f's walked vertices; their
+        // triangles that share no vertex with f (2-ring triangles); those triangles' vertices.
+        outer.clear();
+        for (Index v : f)
+          if (walked(v))
+            for (Index g : vertex_triangles(v))
+              for (Index w : faces_[static_cast<std::size_t>(g)])
+                if (!own(w) && walked(w) && outer_mark[static_cast<std::size_t>(w)] != stamp) {
+                  outer_mark[static_cast<std::size_t>(w)] = stamp;
+                  outer.push_back(w);
+                }
+        verts.clear();
+        for (Index w : outer)
+          for (Index h : vertex_triangles(w)) {
+            std::uint32_t& m = tri_mark[static_cast<std::size_t>(h)];
+            if (m == stamp) continue;
+            m = stamp;
+            const Face& hf = faces_[static_cast<std::size_t>(h)];
+            if (share_vertex(f, hf)) continue;
+            for (Index b : hf)
+              if (vert_mark[static_cast<std::size_t>(b)] != stamp) {
+                vert_mark[static_cast<std::size_t>(b)] = stamp;
+                verts.push_back(b);
+              }
+          }
+        std::sort(verts.begin(), verts.end());
+        values[blk].insert(values[blk].end(), verts.begin(), verts.end());
+        counts[blk].push_back(static_cast<Index>(verts.size()));
+      }
+    });
+    IndexRows rows;
+    rows.offsets.assign(nt + 1, 0);
+    std::size_t u = 0;
+    for (std::size_t blk = 0; blk < blocks; ++blk) {
+      for (const Index c : counts[blk]) {
+        rows.offsets[u + 1] = rows.offsets[u] + c;
+        ++u;
+      }
+      rows.values.insert(rows.values.end(), values[blk].begin(), values[blk].end());
     }
     ring2_vertices_ = std::move(rows);
   });
+}
+
+IndexSpan Adjacency::ring2_vertices(Index t) const {
+  prepare_ring2_vertices(1);
   return ring2_vertices_.row(t);
 }
 

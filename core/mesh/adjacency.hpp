@@ -83,6 +83,9 @@ class Adjacency {
   /// valence V, the whole 2-ring would cost of the order of V per triangle, V^2 in all.
   /// Computed for every triangle on the first call (thread-safe) and cached.
   IndexSpan ring2_vertices(Index t) const;
+  /// Computes what ring2_vertices() returns for every triangle, on up to `threads` threads,
+  /// unless done already (later calls return at once).
+  void prepare_ring2_vertices(int threads) const;
 
   /// True when faces f and g share a vertex (f == g included): "adjacent" in DESIGN.md.
   static bool share_vertex(const Face& f, const Face& g) {

@@ -145,8 +145,11 @@ std::vector<std::vector<double>> ring2_upper_bounds(const Frame& frame, int thre
   parallel_for(n_obj, threads, [&](size_t i) {
     if (out[i].empty()) return;
     adj[i] = &adjacency(*frame.objects[i].topology);
-    adj[i]->ring2_vertices(0);  // computed and cached on the first frame of a topology
   });
+  // Computed and cached on the first frame of a topology: the objects one after the other,
+  // each on all threads (one large object is the common case).
+  for (size_t i = 0; i < n_obj; ++i)
+    if (adj[i] != nullptr) adj[i]->prepare_ring2_vertices(threads);
   parallel_for(blocks.size(), threads, [&](size_t item) {
     const auto [object, block] = blocks.locate(item);
     const size_t i = object;  // a plain variable: lambdas below capture it
