@@ -38,6 +38,44 @@ std::vector<AABB> TriangleBvh::node_unions(const std::vector<AABB>& boxes) const
   return out;
 }
 
+std::vector<std::array<Index, 3>> TriangleBvh::node_common_vertices(const std::vector<Face>& faces) const {
+  constexpr std::array<Index, 3> kNone{kNoIndex, kNoIndex, kNoIndex};
+  // The vertices of `a` that `keep` also holds, ascending.
+  auto intersect = [](const std::array<Index, 3>& a, auto&& keep) {
+    std::array<Index, 3> out{kNoIndex, kNoIndex, kNoIndex};
+    int n = 0;
+    for (Index v : a)
+      if (v != kNoIndex && keep(v)) out[static_cast<size_t>(n++)] = v;
+    return out;
+  };
+  auto holds = [](const std::array<Index, 3>& a, Index v) { return a[0] == v || a[1] == v || a[2] == v; };
+  std::vector<std::array<Index, 3>> out(nodes_.size(), kNone);
+  // Children come after their parent in nodes_, so a reverse pass sees them first.
+  for (size_t n = nodes_.size(); n-- > 0;) {
+    const Node& node = nodes_[n];
+    std::array<Index, 3> common;
+    if (node.count > 0) {
+      std::array<Index, 3> first = faces[static_cast<size_t>(order_[static_cast<size_t>(node.first)])];
+      std::sort(first.begin(), first.end());
+      first = intersect(first, [&, prev = kNoIndex](Index v) mutable {  // distinct vertices only
+        const bool fresh = v != prev;
+        prev = v;
+        return fresh;
+      });
+      common = first;
+      for (std::int32_t k = node.first + 1; k < node.first + node.count; ++k) {
+        const Face& f = faces[static_cast<size_t>(order_[static_cast<size_t>(k)])];
+        common = intersect(common, [&](Index v) { return holds(f, v); });
+      }
+    } else {
+      const auto& right = out[static_cast<size_t>(node.first) + 1];
+      common = intersect(out[static_cast<size_t>(node.first)], [&](Index v) { return holds(right, v); });
+    }
+    out[n] = common;
+  }
+  return out;
+}
+
 // Depth stays below 64 (the query stack size): each split halves the range, and ranges of at
 // most kLeafSize are leaves, so depth <= log2(2^31) + 1.
 void TriangleBvh::build_node(std::int32_t slot, std::int32_t begin, std::int32_t end,

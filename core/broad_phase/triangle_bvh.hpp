@@ -5,6 +5,7 @@
 #include "core/broad_phase/aabb.hpp"
 
 #include <algorithm>
+#include <array>
 #include <functional>
 #include <limits>
 #include <vector>
@@ -21,7 +22,18 @@ class TriangleBvh {
   /// of `query`, nearest subtrees first. `bound()` is re-read as the search goes (visit may
   /// lower it), so later subtrees are pruned against the current value.
   template <typename Bound, typename Visit>
-  void query(const AABB& query, const Bound& bound, const Visit& visit) const;
+  void query(const AABB& query, const Bound& bound, const Visit& visit) const {
+    this->query(query, bound, visit, [](std::int32_t) { return false; });
+  }
+  /// The same, without entering a subtree for which skip(node index) is true.
+  template <typename Bound, typename Visit, typename Skip>
+  void query(const AABB& query, const Bound& bound, const Visit& visit, const Skip& skip) const;
+
+  /// Per node, the vertices that every triangle of its subtree uses (at most 3, ascending,
+  /// kNoIndex after the last), given the triangles' faces: a search for a triangle f can skip
+  /// a subtree holding one of f's vertices, all of whose triangles are then adjacent to f (the
+  /// triangles around a vertex used by thousands of them overlap each other's boxes there).
+  std::vector<std::array<Index, 3>> node_common_vertices(const std::vector<Face>& faces) const;
 
   bool empty() const { return nodes_.empty(); }
 
@@ -50,16 +62,17 @@ class TriangleBvh {
   std::vector<AABB> leaf_boxes_;  ///< boxes in order_ order
 };
 
-template <typename Bound, typename Visit>
-void TriangleBvh::query(const AABB& q, const Bound& bound, const Visit& visit) const {
+template <typename Bound, typename Visit, typename Skip>
+void TriangleBvh::query(const AABB& q, const Bound& bound, const Visit& visit, const Skip& skip) const {
   if (nodes_.empty()) return;
   std::int32_t stack[64];
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
-    const Node& node = nodes_[static_cast<size_t>(stack[--top])];
+    const std::int32_t at = stack[--top];
+    const Node& node = nodes_[static_cast<size_t>(at)];
     double b = bound();
-    if (box_distance_squared(q, node.box) > b * b) continue;
+    if (box_distance_squared(q, node.box) > b * b || skip(at)) continue;
     if (node.count > 0) {
       for (std::int32_t k = node.first; k < node.first + node.count; ++k) {
         const double d2 = box_distance_squared(q, leaf_boxes_[static_cast<size_t>(k)]);

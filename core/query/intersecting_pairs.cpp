@@ -53,6 +53,14 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
     }
   }
   boxes.build_bvhs(threads, [&](size_t i) { return needs_bvh[i] != 0; });
+  // Within an object, subtrees all of whose triangles share one of f's vertices hold no
+  // candidate (thousands of triangles around one vertex overlap each other's boxes there).
+  std::vector<std::vector<std::array<Index, 3>>> common(n);
+  if (opts.intra)
+    parallel_for(n, threads, [&](size_t i) {
+      if (frame.objects[i].num_triangles() > 0)
+        common[i] = boxes.bvh(i).node_common_vertices(frame.objects[i].topology->faces);
+    });
 
   const VoronoiBounds* voronoi = opts.voronoi;
   std::vector<std::vector<IntersectingPair>> found(items.size());
@@ -67,7 +75,13 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
     if (w.i == w.j) {
       for (Index f = w.first; f < w.last; ++f) {
         const Face& ff = oi.topology->faces[static_cast<size_t>(f)];
-        boxes.bvh(static_cast<size_t>(w.i)).query_overlaps(tb_i[static_cast<size_t>(f)], no_skip, [&](Index g) {
+        const auto& node_common = common[static_cast<size_t>(w.i)];
+        auto adjacent_subtree = [&](std::int32_t node) {
+          for (const Index v : node_common[static_cast<size_t>(node)])
+            if (v != kNoIndex && (v == ff[0] || v == ff[1] || v == ff[2])) return true;
+          return false;
+        };
+        boxes.bvh(static_cast<size_t>(w.i)).query_overlaps(tb_i[static_cast<size_t>(f)], adjacent_subtree, [&](Index g) {
           if (g <= f || Adjacency::share_vertex(ff, oi.topology->faces[static_cast<size_t>(g)])) return;
           ++tests[k];
           if (triangles_intersect(oi.triangle(f), oi.triangle(g))) hits.push_back({w.i, f, w.i, g});

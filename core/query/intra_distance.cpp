@@ -193,9 +193,11 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     return n < 2 ? 0 : ObjectBlocks::blocks_of(n);
   });
   std::vector<std::unique_ptr<SharedPairs>> shared(n_obj);
+  std::vector<std::vector<std::array<Index, 3>>> common(n_obj);
   parallel_for(n_obj, threads, [&](size_t i) {
     if (blocks.count(i) == 0) return;
-    boxes.bvh(i);  // built here, over objects in parallel, rather than by a block's thread
+    // Built here, over objects in parallel, rather than by a block's thread.
+    common[i] = boxes.bvh(i).node_common_vertices(frame.objects[i].topology->faces);
     shared[i] = std::make_unique<SharedPairs>(boxes.triangles[i].size());
   });
 
@@ -223,6 +225,14 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
       auto bound = [&] { return std::min(u, pairs.current(uf)) + slack; };
       // Nearest boxes first, so that the bound drops early. A pair at distance d <= bound
       // has D_l(g) <= SD(g) <= d (f is non-adjacent to g), so the D_l cut loses nothing.
+      // Subtrees all of whose triangles share one of f's vertices hold no candidate.
+      const Face& ff = o.topology->faces[uf];
+      const auto& node_common = common[i];
+      auto adjacent_subtree = [&](std::int32_t node) {
+        for (const Index v : node_common[static_cast<size_t>(node)])
+          if (v != kNoIndex && (v == ff[0] || v == ff[1] || v == ff[2])) return true;
+        return false;
+      };
       bvh.query(tboxes[uf], bound, [&](Index g, double box_d2) {
         if (g == f || shares_vertex(o, f, g)) return;
         ++c.intra_candidates;
@@ -251,7 +261,7 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
         const TriangleDistanceResult r = evaluate(o, f, g);
         pairs.offer(res.per_triangle[uf], uf, g, r);
         pairs.offer(res.per_triangle[ug], ug, f, swapped(r));
-      });
+      }, adjacent_subtree);
       pairs.finish(uf);
     }
   });

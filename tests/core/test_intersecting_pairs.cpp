@@ -8,6 +8,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <memory>
+
 namespace vproxq {
 namespace {
 
@@ -54,6 +57,41 @@ TEST(IntersectingPairs, RandomScenesEqualBruteForce) {
   // The scenes must exercise both kinds, or the comparison proves little.
   EXPECT_GT(total_inter, 50u);
   EXPECT_GT(total_intra, 50u);
+}
+
+TEST(IntersectingPairs, FanAroundAHubWithCrossingTrianglesEqualsBruteForce) {
+  // 300 slivers around vertex 0 overlap each other's boxes at the hub; subtrees of slivers
+  // only are skipped as all adjacent (TriangleBvh::node_common_vertices()). Triangles of the
+  // same object cross the fan without touching the hub: their pairs must all be found.
+  const int n = 300;
+  auto topo = std::make_shared<Topology>();
+  Object o;
+  o.name = "fan";
+  o.positions.push_back(Vec3::Zero());
+  for (int k = 0; k < n; ++k) {
+    const double a = 2 * M_PI * k / n;
+    o.positions.emplace_back(std::cos(a), std::sin(a), 0.01 * std::sin(7 * a));
+  }
+  for (Index k = 0; k < n; ++k) topo->faces.push_back({0, 1 + k, 1 + (k + 1) % n});
+  Rng rng(3);
+  for (int c = 0; c < 12; ++c) {
+    const Index base = static_cast<Index>(o.positions.size());
+    const Vec3 at(rng.uniform(-0.7, 0.7), rng.uniform(-0.7, 0.7), 0);
+    o.positions.push_back(at + Vec3(rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), -0.2));
+    o.positions.push_back(at + Vec3(rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), 0.2));
+    o.positions.push_back(at + Vec3(rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), 0.25));
+    topo->faces.push_back({base, base + 1, base + 2});
+  }
+  topo->num_vertices = static_cast<Index>(o.positions.size());
+  o.topology = topo;
+  Frame frame;
+  frame.objects = {o};
+  const auto ref = intersecting_pairs_brute_force(frame);
+  EXPECT_GT(ref.pairs.size(), 12u);
+  for (int threads : {1, 2}) {
+    const auto got = intersecting_pairs(frame, {threads, nullptr, true});
+    EXPECT_EQ(got.pairs, ref.pairs);
+  }
 }
 
 TEST(IntersectingPairs, CanonicalOrder) {
