@@ -34,6 +34,13 @@ class TriangleBvh {
   /// a subtree holding one of f's vertices, all of whose triangles are then adjacent to f (the
   /// triangles around a vertex used by thousands of them overlap each other's boxes there).
   std::vector<std::array<Index, 3>> node_common_vertices(const std::vector<Face>& faces) const;
+  /// Whether face f uses one of a node's common vertices (a node_common_vertices() entry):
+  /// then every triangle of the node's subtree is adjacent to f.
+  static bool adjacent_subtree(const std::array<Index, 3>& common, const Face& f) {
+    for (const Index v : common)
+      if (v != kNoIndex && (v == f[0] || v == f[1] || v == f[2])) return true;
+    return false;
+  }
 
   bool empty() const { return nodes_.empty(); }
 

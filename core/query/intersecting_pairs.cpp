@@ -77,9 +77,7 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
         const Face& ff = oi.topology->faces[static_cast<size_t>(f)];
         const auto& node_common = common[static_cast<size_t>(w.i)];
         auto adjacent_subtree = [&](std::int32_t node) {
-          for (const Index v : node_common[static_cast<size_t>(node)])
-            if (v != kNoIndex && (v == ff[0] || v == ff[1] || v == ff[2])) return true;
-          return false;
+          return TriangleBvh::adjacent_subtree(node_common[static_cast<size_t>(node)], ff);
         };
         boxes.bvh(static_cast<size_t>(w.i)).query_overlaps(tb_i[static_cast<size_t>(f)], adjacent_subtree, [&](Index g) {
           if (g <= f || Adjacency::share_vertex(ff, oi.topology->faces[static_cast<size_t>(g)])) return;

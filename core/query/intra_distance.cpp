@@ -142,14 +142,17 @@ std::vector<std::vector<double>> ring2_upper_bounds(const Frame& frame, int thre
     out[i].assign(static_cast<size_t>(frame.objects[i].num_triangles()), kInfinity);
   const ObjectBlocks blocks(n_obj, [&](size_t i) { return ObjectBlocks::blocks_of(out[i].size()); });
   std::vector<const Adjacency*> adj(n_obj, nullptr);
+  // The 2-ring vertices are computed and cached on the first frame of a topology: small
+  // objects in parallel, each on one thread; then large ones one after the other, each on all
+  // threads.
+  constexpr size_t kLargeObject = 4096;  // triangles
   parallel_for(n_obj, threads, [&](size_t i) {
     if (out[i].empty()) return;
     adj[i] = &adjacency(*frame.objects[i].topology);
+    if (out[i].size() < kLargeObject) adj[i]->prepare_ring2_vertices(1);
   });
-  // Computed and cached on the first frame of a topology: the objects one after the other,
-  // each on all threads (one large object is the common case).
   for (size_t i = 0; i < n_obj; ++i)
-    if (adj[i] != nullptr) adj[i]->prepare_ring2_vertices(threads);
+    if (adj[i] != nullptr && out[i].size() >= kLargeObject) adj[i]->prepare_ring2_vertices(threads);
   parallel_for(blocks.size(), threads, [&](size_t item) {
     const auto [object, block] = blocks.locate(item);
     const size_t i = object;  // a plain variable: lambdas below capture it
@@ -229,9 +232,7 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
       const Face& ff = o.topology->faces[uf];
       const auto& node_common = common[i];
       auto adjacent_subtree = [&](std::int32_t node) {
-        for (const Index v : node_common[static_cast<size_t>(node)])
-          if (v != kNoIndex && (v == ff[0] || v == ff[1] || v == ff[2])) return true;
-        return false;
+        return TriangleBvh::adjacent_subtree(node_common[static_cast<size_t>(node)], ff);
       };
       bvh.query(tboxes[uf], bound, [&](Index g, double box_d2) {
         if (g == f || shares_vertex(o, f, g)) return;

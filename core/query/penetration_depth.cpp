@@ -42,17 +42,15 @@ int orient_yz_perturbed(const Vec3& u, const Vec3& w, const Vec3& p) {
   return 0;  // u and w project onto one point: the face's projection is flat (s == 0)
 }
 
-/// The signed crossing of triangle t by the ray from p: +1/-1, 0 (missed), or sets on_surface.
-int ray_crossing(const Vec3& p, const Triangle& t, bool& on_surface) {
+/// The signed crossing of triangle t by the ray from p: +1/-1, or 0 (missed). p must not lie
+/// on t (callers test on_triangle() first): in t's plane and inside its closed projection, p
+/// would be on t, so orient3d is then nonzero.
+int ray_crossing(const Vec3& p, const Triangle& t) {
   const int s = orient2d_projected(t[0], t[1], t[2], 0);
   if (s == 0) return 0;
   for (int k = 0; k < 3; ++k)
     if (orient_yz_perturbed(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)], p) != s) return 0;
   const int above = orient3d(t[0], t[1], t[2], p);  // sign of n.(p - a) = n.x (p.x - plane.x)
-  if (above == 0) {
-    on_surface = true;  // p is in the plane and inside the (closed) projection: on t
-    return 0;
-  }
   return above == -s ? s : 0;  // ahead of p iff p.x < plane.x iff sign(n.(p-a)) == -sign(n.x)
 }
 
@@ -80,11 +78,8 @@ int winding_number(const Vec3& p, const Object& o, const TriangleBvh& bvh, bool&
   ray.lo = p;
   ray.hi = Vec3(kInfinity, p.y(), p.z());
   int w = 0;
-  bvh.query(ray, [] { return 0.0; }, [&](Index t, double) {
-    if (on_surface) return;
-    w += ray_crossing(p, o.triangle(t), on_surface);
-  });
-  return on_surface ? 0 : w;
+  bvh.query(ray, [] { return 0.0; }, [&](Index t, double) { w += ray_crossing(p, o.triangle(t)); });
+  return w;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -857,10 +852,7 @@ int winding_number_brute_force(const Vec3& p, const Object& object, bool& on_sur
       return 0;
     }
   int w = 0;
-  for (Index t = 0; t < object.num_triangles(); ++t) {
-    w += ray_crossing(p, object.triangle(t), on_surface);
-    if (on_surface) return 0;
-  }
+  for (Index t = 0; t < object.num_triangles(); ++t) w += ray_crossing(p, object.triangle(t));
   return w;
 }
 

@@ -209,7 +209,7 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
       // The object's triangle boxes are widened by its own share of the margin; the prisms
       // below by the step's whole margin: the grid covers the larger.
       AABB box = sweep.objects[i];
-      const double more = i < sweep.widening.size() ? std::max(0.0, sweep.margin - sweep.widening[i]) : 0.0;
+      const double more = std::max(0.0, sweep.margin - sweep.widening[i]);
       box.lo.array() -= more;
       box.hi.array() += more;
       scene.extend(box);
