@@ -5,6 +5,7 @@
 #include "io/json_writer.hpp"
 
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <csignal>
 #include <chrono>
@@ -26,11 +27,15 @@ namespace fs = std::filesystem;
 
 // ---- Cleanup on a fatal signal ---------------------------------------------------------
 //
-// A run stopped by SIGINT, SIGTERM or SIGHUP (Ctrl-C, timeout, a closed terminal) would
-// otherwise leave its temporary files and the directories it created. The paths live in
-// fixed slots that the handler reads with async-signal-safe calls only (unlink, rmdir,
-// signal, raise): files first, then directories, newest first; then the signal is raised
-// again with its default action, so the exit status still says which signal ended the run.
+// A run stopped by SIGINT, SIGTERM or SIGHUP (Ctrl-C, timeout, a closed terminal), or ended by
+// a crash (SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT), would otherwise leave its temporary files
+// and the directories it created. The paths live in fixed slots that the handler reads with
+// async-signal-safe calls only (unlink, rmdir, signal, raise): files first, then directories,
+// newest first; then the signal is raised again with its default action, so the exit status
+// (and a core dump, where enabled) still says which signal ended the run. The handler runs on
+// its own stack, so that a stack overflow still reaches it. What no handler sees (SIGKILL, as
+// from the out-of-memory killer) is cleaned up by the next run into the same directory:
+// remove_stale_temporaries().
 constexpr int kCleanupSlots = 16;
 constexpr std::size_t kCleanupPathMax = 4096;
 struct CleanupSlot {
@@ -51,11 +56,17 @@ extern "C" void remove_partial_output(int sig) {
 /// signal the caller ignores stays ignored).
 void install_cleanup_handlers() {
   static const bool installed = [] {
-    for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    static char alternate_stack[1 << 16];
+    stack_t ss{};
+    ss.ss_sp = alternate_stack;
+    ss.ss_size = sizeof alternate_stack;
+    const bool on_stack = ::sigaltstack(&ss, nullptr) == 0;
+    for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) {
       struct sigaction old {};
       if (::sigaction(sig, nullptr, &old) != 0 || old.sa_handler != SIG_DFL) continue;
       struct sigaction act {};
       act.sa_handler = remove_partial_output;
+      act.sa_flags = on_stack ? SA_ONSTACK : 0;
       sigemptyset(&act.sa_mask);
       ::sigaction(sig, &act, nullptr);
     }
@@ -124,8 +135,48 @@ class TempPath {
   int slot_ = -1;
 };
 
+/// This machine's name, reduced to [A-Za-z0-9.-] (it goes into file names).
+const std::string& host_tag() {
+  static const std::string tag = [] {
+    char name[256] = {};
+    if (::gethostname(name, sizeof name - 1) != 0) name[0] = '\0';
+    std::string t;
+    for (const char* c = name; *c != '\0'; ++c)
+      if (std::isalnum(static_cast<unsigned char>(*c)) || *c == '.' || *c == '-') t += *c;
+    return t.empty() ? std::string("host") : t;
+  }();
+  return tag;
+}
+
+/// `.NAME.tmp-HOST-PID`: the host and the process, so that a later run can tell a temporary
+/// left by a process that no longer exists (remove_stale_temporaries()).
 fs::path temp_name(const fs::path& dir, const char* final_name) {
-  return dir / ("." + std::string(final_name) + ".tmp-" + std::to_string(::getpid()));
+  return dir / ("." + std::string(final_name) + ".tmp-" + host_tag() + "-" + std::to_string(::getpid()));
+}
+
+/// Removes `.results.json.tmp-HOST-PID` and `.results.h5.tmp-HOST-PID` files in `dir` that a
+/// run on this host left when it was killed without a chance to clean up (SIGKILL, power
+/// loss): the host is this one and no process PID exists. Temporaries of live runs, of other
+/// hosts (a shared file system) and anything else are left alone; so is an earlier
+/// results.h5 moved aside during a commit (`.results.h5.previous.tmp-*`), which may be the
+/// only copy of earlier results.
+void remove_stale_temporaries(const fs::path& dir) {
+  std::error_code ec;
+  fs::directory_iterator it(dir, ec), end;
+  for (; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    for (const char* final_name : {"results.json", "results.h5"}) {
+      const std::string prefix = "." + std::string(final_name) + ".tmp-" + host_tag() + "-";
+      if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+      const std::string digits = name.substr(prefix.size());
+      if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+      const long pid = std::stol(digits);
+      if (pid <= 0 || pid == ::getpid()) continue;
+      if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;  // alive, or unknown
+      std::error_code ignored;
+      if (fs::is_regular_file(fs::symlink_status(it->path(), ignored))) fs::remove(it->path(), ignored);
+    }
+  }
 }
 
 /// The directories that prepare_dir() created for a run (deepest last), removed again when
@@ -175,6 +226,7 @@ fs::path prepare_dir(const fs::path& out_dir, CreatedDirs& created) {
   if (!fs::is_directory(out_dir, ec)) {
     throw RuntimeError("output path '" + out_dir.string() + "' is not a directory");
   }
+  remove_stale_temporaries(out_dir);
   return out_dir;
 }
 

@@ -8,7 +8,11 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cctype>
 #include <fstream>
+
+#include <sys/wait.h>
+#include <unistd.h>
 
 namespace vproxq {
 namespace {
@@ -177,19 +181,52 @@ TEST(Cli, InputErrorsNameTheFileAndLeaveNoOutput) {
 // way, but a shell starts background jobs with it ignored) removes its temporary files and the
 // directories it created, then ends by that signal. The run is a slow one (a very fine grid on
 // one thread), signalled once its temporary files exist.
+// A crash (SIGSEGV, SIGABRT, ...) is cleaned up the same way; those are sent here with kill.
 TEST(Cli, ARunEndedByASignalLeavesNothingBehind) {
-  for (const auto& [sig, number] : {std::pair<const char*, int>{"TERM", 15}, {"HUP", 1}}) {
+  for (const auto& [sig, number] : {std::pair<const char*, int>{"TERM", 15}, {"HUP", 1}, {"SEGV", 11}, {"ABRT", 6}}) {
     SCOPED_TRACE(sig);
     ScratchDir dir;
     const auto out = dir / "a" / "out";
     const std::string run = std::string(VPROXQ_BINARY) + " " + quote(kSamples / "skirt-tiny" / "scene.json") +
                             " --voronoi=cpu --grid 4096 --threads 1 --quiet -o " + quote(out);
-    const auto r = test::run_command(run + " & pid=$!; for i in $(seq 600); do ls " + quote(out) +
+    const auto r = test::run_command("ulimit -c 0; " + run + " & pid=$!; for i in $(seq 600); do ls " + quote(out) +
                                      "/.results.json.tmp-* >/dev/null 2>&1 && break; sleep 0.05; done; kill -" +
                                      sig + " $pid; wait $pid; echo \"status $?\"");
     EXPECT_NE(r.output.find("status " + std::to_string(128 + number)), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(dir / "a")) << r.output;
   }
+}
+
+// A run killed without a chance to clean up (SIGKILL, the out-of-memory killer) leaves its
+// temporaries; the next run into the same directory removes those of processes of this host
+// that no longer exist, and nothing else.
+TEST(Cli, StaleTemporariesOfDeadRunsAreRemoved) {
+  char name[256] = {};
+  ASSERT_EQ(::gethostname(name, sizeof name - 1), 0);
+  std::string host;
+  for (const char* c = name; *c != '\0'; ++c)
+    if (std::isalnum(static_cast<unsigned char>(*c)) || *c == '.' || *c == '-') host += *c;
+  if (host.empty()) host = "host";
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) ::_exit(0);
+  ASSERT_EQ(::waitpid(child, nullptr, 0), child);  // `child` no longer exists
+  const std::string dead = std::to_string(child), alive = std::to_string(::getpid());
+
+  ScratchDir dir;
+  const std::vector<std::string> stale = {".results.json.tmp-" + host + "-" + dead,
+                                          ".results.h5.tmp-" + host + "-" + dead};
+  const std::vector<std::string> kept = {".results.json.tmp-" + host + "-" + alive,
+                                         ".results.h5.tmp-other-host-" + dead,
+                                         ".results.h5.previous.tmp-" + host + "-" + dead,
+                                         ".results.json.tmp-" + host + "-" + dead + "x", "notes.txt"};
+  for (const auto& f : stale) dir.write("out/" + f, "partial\n");
+  for (const auto& f : kept) dir.write("out/" + f, "keep\n");
+  const auto r = vproxq(quote(kSamples / "two-cubes" / "scene.json") + " --frames 0:1 --quiet -o " + quote(dir / "out"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "out" / "results.json"));
+  for (const auto& f : stale) EXPECT_FALSE(fs::exists(dir / "out" / f)) << f;
+  for (const auto& f : kept) EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
 }
 
 TEST(Cli, FailedRunRemovesTheDirectoriesItCreated) {
