@@ -156,7 +156,6 @@ InterDistanceOutput inter_object_distance(const Frame& frame, const FrameBoxes& 
   InterDistanceOutput out;
   const size_t n = frame.objects.size();
   const int threads = std::max(1, opts.threads);
-  const double slack = rounding_slack(boxes.magnitude);
   Stopwatch sw;
   out.per_object.resize(n);
   boxes.build_bvhs(threads, [](size_t) { return true; });
@@ -167,6 +166,13 @@ InterDistanceOutput inter_object_distance(const Frame& frame, const FrameBoxes& 
     thread_local SearchScratch scratch;
     // D_u(O_i): Stage II's bound when it ran, else Stage I's.
     const double u = opts.voronoi ? opts.voronoi->object_upper[ui] : stage1.upper_bound[ui];
+    // The slack covers the rounding of the distances and bounds of the pairs compared: those of
+    // i's pairs with its PNS, whose objects include every object within U_i of i (the PNS has
+    // all within U_i plus the frame's slack, which is at least this one). Their coordinates,
+    // not the frame's, set it: an object parked far away no longer widens everyone's search.
+    double magnitude = boxes.magnitudes[ui];
+    for (Index j : stage1.pns[ui]) magnitude = std::max(magnitude, boxes.magnitudes[static_cast<size_t>(j)]);
+    const double slack = rounding_slack(magnitude);
     search_object(frame, boxes, stage1.pns[ui], i, u, slack, opts.voronoi, best, scratch,
                   counters[ui]);
     out.per_object[ui] = to_result(i, best);

@@ -55,6 +55,27 @@ TEST(InterDistance, LargeCoordinateOffsetEqualsBruteForce) {
   test::expect_same_inter(inter_object_distance(frame, {2}), inter_object_distance_brute_force(frame), "offset 1e6");
 }
 
+TEST(InterDistance, AFarAwayObjectDoesNotWidenTheOthersSearch) {
+  // The rounding slack of an object's search comes from the coordinates of the objects within
+  // its bound: a blob parked at 1e12 (whose slack is 100 units) must not turn the search among
+  // the objects near the origin, all within 100 of each other, into all pairs.
+  Rng rng(11);
+  const Frame near = make_random_frame(3, 8, 1.5, 1);
+  Frame with_far = near;
+  with_far.objects.push_back(make_blob(rng, Vec3::Constant(1e12), 1.0, 1, 0.2, "far"));
+  const auto ref = inter_object_distance_brute_force(with_far);
+  const auto got = inter_object_distance(with_far, {2});
+  test::expect_same_inter(got, ref, "blobs and a far blob");
+  // Only the far blob's own search may test more than the near ones do among themselves: at
+  // most every pair of its triangles with the triangles near the origin.
+  const auto alone = inter_object_distance(near, {2});
+  std::uint64_t near_triangles = 0;
+  for (const auto& o : near.objects) near_triangles += static_cast<std::uint64_t>(o.num_triangles());
+  const auto far_triangles = static_cast<std::uint64_t>(with_far.objects.back().num_triangles());
+  EXPECT_LE(got.counters.exact_tests, alone.counters.exact_tests + far_triangles * near_triangles);
+  EXPECT_LT(got.counters.exact_tests, ref.counters.exact_tests / 4);
+}
+
 TEST(InterDistance, TiesGoToTheSmallestIds) {
   // Object 0 in the middle, objects 1 and 2 are mirror images at exactly the same distance;
   // object 3 is a copy of 2 (same distance to 0, larger id). Nearest of 0 must be 1.
