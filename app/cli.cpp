@@ -48,7 +48,7 @@ FrameRange parse_frame_range(const std::string& text) {
   const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
   if (!a.empty()) r.first = parse_part(a);
   if (!b.empty()) r.last = parse_part(b);
-  if (r.first && r.last && *r.last <= *r.first)
+  if (r.last && *r.last <= r.first.value_or(0))
     throw UsageError("--frames " + text + ": the range is empty (B is exclusive and must exceed A)");
   return r;
 }
@@ -198,7 +198,8 @@ int cli_main(int argc, char** argv) {
   app.add_option("--queries", config.queries,
                  "comma-separated queries to run (default: the scene's \"queries\", else "
                  "distance). Valid: " + query_names_list())
-      ->delimiter(',');
+      ->delimiter(',')
+      ->allow_extra_args(false);  // one comma-separated value: `--queries=distance SCENE` keeps SCENE
   app.add_option("-o,--output", config.output_dir,
                  "write OUT/results.json and OUT/results.h5 (default: print a summary)")
       ->check([](const std::string& dir) { return dir.empty() ? std::string("the output directory must not be empty") : std::string(); });

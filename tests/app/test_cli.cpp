@@ -121,6 +121,16 @@ TEST(Cli, UsageErrors) {
   EXPECT_NE(r.output.find("has 3 frames"), std::string::npos) << r.output;
   r = vproxq(scene + " --frames=2:1");
   EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = vproxq(scene + " --frames=:0");  // the same empty range as 0:0, not a run of 0 frames
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("empty"), std::string::npos) << r.output;
+  // --queries takes one comma-separated value: before SCENE it leaves SCENE alone, and a
+  // space-separated list is not silently taken.
+  r = vproxq("--queries=distance,ccd " + scene + " --quiet");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  r = vproxq(scene + " --queries distance ccd --quiet");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("ccd"), std::string::npos) << r.output;
   r = vproxq(scene + " --frames=x");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   r = vproxq(scene + " --frames=99999999999999999999:");  // past long: a usage error, not a crash
