@@ -286,6 +286,10 @@ void run(const Config& config) {
                                               CcdOptions{info.threads, voxels ? &*voxels : nullptr});
       c.aabb_ms += sweep_ms;
       c.voronoi_ms = voxel_ms;
+      if (voxels) {
+        c.voxel_grid = voxels->grid().dims;
+        c.voxel_cell = voxels->grid().cell;
+      }
       result.time_ms.aabb += c.aabb_ms;
       result.time_ms.voronoi += c.voronoi_ms;
       result.time_ms.exact += c.exact_ms;

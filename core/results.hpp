@@ -3,6 +3,7 @@
 #include "core/geometry/triangle_distance.hpp"
 #include "core/types.hpp"
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -212,6 +213,9 @@ struct CcdStepResult {
   std::vector<CcdEdgeEdge> ee;
   CcdCounters counters;
   double aabb_ms = 0, voronoi_ms = 0, exact_ms = 0;
+  /// Stage II's space-time grid when it ran: voxels per axis and the cell's side.
+  std::optional<std::array<std::int32_t, 3>> voxel_grid;
+  double voxel_cell = 0;
 };
 
 struct ObjectInfo {

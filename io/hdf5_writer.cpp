@@ -579,6 +579,12 @@ struct Hdf5ResultWriter::Impl {
     write_attribute(g, ccd_where, "time_ms_aabb", c.aabb_ms);
     write_attribute(g, ccd_where, "time_ms_voronoi", c.voronoi_ms);
     write_attribute(g, ccd_where, "time_ms_exact", c.exact_ms);
+    if (c.voxel_grid) {
+      write_attribute(g, ccd_where, "voronoi_grid_x", (*c.voxel_grid)[0]);
+      write_attribute(g, ccd_where, "voronoi_grid_y", (*c.voxel_grid)[1]);
+      write_attribute(g, ccd_where, "voronoi_grid_z", (*c.voxel_grid)[2]);
+      write_attribute(g, ccd_where, "voronoi_cell", c.voxel_cell);
+    }
     close_checked(ccd, "H5Gclose", ccd_where);
   }
 

@@ -97,6 +97,10 @@ Json ccd_stats_json(const CcdStepResult& c) {
   r["limit_hits"] = k.limit_hits;
   r["vf_pairs"] = c.vf.size();
   r["ee_pairs"] = c.ee.size();
+  if (c.voxel_grid) {
+    r["grid"] = {(*c.voxel_grid)[0], (*c.voxel_grid)[1], (*c.voxel_grid)[2]};
+    r["cell"] = c.voxel_cell;
+  }
   r["time_ms"] = {{"aabb", c.aabb_ms}, {"voronoi", c.voronoi_ms}, {"exact", c.exact_ms}};
   return r;
 }

@@ -44,10 +44,13 @@ struct StageGrid {
     // A box of zero extent (every point at one place) still gets cells whose squares, in
     // extent below, do not underflow to 0 (which would make `unit` 0).
     const double longest = std::max(ext.maxCoeff(), 0x1p-400);
+    // `resolution` cells cover the longest axis: the quotient rounded down would need one more
+    // (--grid 50 gave 51 cells on a scene), so the cell is rounded up until they do.
     g.grid.cell = longest / resolution;
+    while (g.grid.cell * resolution < longest) g.grid.cell = std::nextafter(g.grid.cell, kInfinity);
     g.grid.origin = box.lo;
     for (int k = 0; k < 3; ++k)
-      g.grid.dims[k] = std::max<std::int32_t>(1, static_cast<std::int32_t>(std::ceil(ext[k] / g.grid.cell)));
+      g.grid.dims[k] = std::clamp<std::int32_t>(static_cast<std::int32_t>(std::ceil(ext[k] / g.grid.cell)), 1, resolution);
     g.extent = (g.grid.cell * Vec3(g.grid.dims[0], g.grid.dims[1], g.grid.dims[2])).norm();
     g.voxel_slack = kVoxelSlackRel * (g.extent + g.grid.cell);
     g.half = 0.5 * g.grid.cell + g.voxel_slack;

@@ -9,6 +9,8 @@
 #include "support/random_scene.hpp"
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
 #include <nlohmann/json.hpp>
 
 #include <fstream>
@@ -136,6 +138,13 @@ TEST(CcdCli, BackendsGiveIdenticalResultsEqualToBruteForce) {
       const auto& g = gpu["frames"][f]["stats"]["ccd"];
       for (const char* key : {"elementary_tests", "triangle_pairs", "culled_triangles", "object_pairs"})
         EXPECT_EQ(c[key].get<std::uint64_t>(), g[key].get<std::uint64_t>()) << "frame " << f << " " << key;
+      // The grid Stage II used is recorded (cells of 1/24 of the swept box's longest side, plus
+      // the boundary cell); without Stage II there is none.
+      ASSERT_TRUE(c.contains("grid") && c.contains("cell")) << c.dump();
+      EXPECT_EQ(c["grid"], g["grid"]);
+      EXPECT_EQ(std::max({c["grid"][0].get<int>(), c["grid"][1].get<int>(), c["grid"][2].get<int>()}), 25);
+      EXPECT_GT(c["cell"].get<double>(), 0.0);
+      EXPECT_FALSE(off["frames"][f]["stats"]["ccd"].contains("grid"));
       tests_cpu += c["elementary_tests"].get<std::uint64_t>();
       tests_off += off["frames"][f]["stats"]["ccd"]["elementary_tests"].get<std::uint64_t>();
     }

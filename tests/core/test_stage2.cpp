@@ -50,6 +50,29 @@ TEST(Stage2, BoundsHoldAndResultsEqualBruteForce) {
   }
 }
 
+// --grid N means N cells along the longest axis: the quotient longest / N rounded down used to
+// need an extra cell (--grid 50 gave 51 on a sample scene). The N cells must still cover the box.
+TEST(Stage2, GridHasExactlyTheRequestedCellsAlongTheLongestAxis) {
+  test::Rng rng(17);
+  for (int trial = 0; trial < 20000; ++trial) {
+    const int n = 1 + static_cast<int>(rng.uniform(0, 600));
+    AABB box;
+    box.extend(Vec3(rng.uniform(-3, 3), rng.uniform(-3, 3), rng.uniform(-3, 3)));
+    box.extend(Vec3(rng.uniform(-3, 3), rng.uniform(-3, 3), rng.uniform(-3, 3)));
+    const StageGrid sg = StageGrid::over(box, n);
+    const Vec3 ext = box.hi - box.lo;
+    int longest = 0;
+    for (int k = 1; k < 3; ++k)
+      if (ext[k] > ext[longest]) longest = k;
+    ASSERT_EQ(sg.grid.dims[longest], n) << "trial " << trial << " extent " << ext[longest];
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_LE(sg.grid.dims[k], n);
+      // (Within rounding off the longest axis: the voxel slack covers that.)
+      ASSERT_GE(sg.grid.cell * sg.grid.dims[k], ext[k] * (k == longest ? 1 : 1 - 1e-12)) << "trial " << trial;
+    }
+  }
+}
+
 // The voxelization Lemma 2 rests on (StageGrid::voxelize): every voxel holding a point of the
 // triangle is marked (checked at the corners and on a barycentric lattice), and every marked
 // voxel's centre is within sqrt(3) * half of the triangle (so within δ). Triangles of every
