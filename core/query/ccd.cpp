@@ -339,7 +339,9 @@ CcdParticipants ccd_participants(const Frame& from, const Frame& to) {
         continue;
       }
     }
-    if (a.topology != b.topology && *a.topology != *b.topology) {
+    // Faces, not vertex counts: vertices used by no face take no part (an unused vertex
+    // added or dropped between the files of an object changes nothing here).
+    if (a.topology != b.topology && a.topology->faces != b.topology->faces) {
       std::string reason = "topology changes between frames " + std::to_string(from.index) +
                            " and " + std::to_string(to.index);
       if (a.num_vertices() != b.num_vertices() || a.num_triangles() != b.num_triangles())
@@ -384,9 +386,12 @@ CcdSweep CcdSweep::compute(const Frame& from, const Frame& to, int threads) {
     const Object& a = from.objects[i];
     const Object& b = to.objects[i];
     auto& vb = s.vertices[i];
-    vb.resize(a.positions.size());
+    vb.assign(a.positions.size(), AABB{});
     AABB raw;
+    // Only the vertices of faces: the two frames may differ in unused ones (which b may lack).
+    const Adjacency& adj = adjacency(*a.topology);
     for (size_t v = 0; v < vb.size(); ++v) {
+      if (adj.vertex_triangles(static_cast<Index>(v)).empty()) continue;
       vb[v] = swept_box(a, b, {static_cast<Index>(v)});
       raw.extend(vb[v]);
     }

@@ -123,6 +123,36 @@ TEST(CcdPipeline, AFarAwayObjectLeavesTheOthersMarginsAsTheyWere) {
   expect_same_ccd(continuous_collisions(from, to, sweep, CcdOptions{2, &voxels}), ref);
 }
 
+// Vertices used by no face take no part: an unused vertex that one frame's file adds (or
+// lacks) is no topology change, and the step's answer is that of the same step without it.
+TEST(CcdPipeline, AnUnusedVertexInOneFrameOnlyChangesNothing) {
+  const Frame from = test::make_random_frame(41, 3, 1.2, 1);
+  Frame to = moved(from, 42, 0.5, 0.2);
+  to.index = 1;
+  const CcdStepResult plain = continuous_collisions_brute_force(from, to);
+  ASSERT_GT(plain.vf.size() + plain.ee.size(), 0u);
+  ASSERT_TRUE(plain.skipped.empty());
+  auto with_extra = [](Frame f) {
+    Object& o = f.objects[1];
+    auto topo = std::make_shared<Topology>(*o.topology);
+    topo->num_vertices += 1;
+    o.topology = topo;
+    o.positions.push_back(Vec3(50, 50, 50));
+    return f;
+  };
+  for (const bool extra_at_end : {true, false}) {
+    SCOPED_TRACE(extra_at_end ? "added in frame 1" : "dropped in frame 1");
+    const Frame a = extra_at_end ? from : with_extra(from);
+    const Frame b = extra_at_end ? with_extra(to) : to;
+    const CcdStepResult got = continuous_collisions(a, b, CcdOptions{2, nullptr});
+    EXPECT_TRUE(got.skipped.empty());
+    expect_same_ccd(got, plain);
+    const CcdSweep sweep = CcdSweep::compute(a, b, 2);
+    const CcdVoxelCulling voxels(a, b, sweep, 32, 2);
+    expect_same_ccd(continuous_collisions(a, b, sweep, CcdOptions{2, &voxels}), plain);
+  }
+}
+
 TEST(CcdPipeline, TopologyChangeAndMissingObjectAreSkipped) {
   Frame from = test::make_random_frame(3, 3, 2.0, 1);
   Frame to = moved(from, 4, 0.5, 0.1);
