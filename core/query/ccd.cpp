@@ -61,6 +61,8 @@ bool share_endpoint(const std::array<Index, 2>& a, const std::array<Index, 2>& b
 struct SweptTriangle {
   std::array<Vec3, 3> start, end;
   Vec3 normal, corner_sum, normal_end;
+  Vec3 motion;         ///< the sum of its corners' displacements over the step (3x the centroid's)
+  double size2 = 0;    ///< squared diagonal of its box at the start
 };
 
 std::vector<SweptTriangle> swept_triangles(const Object& from, const Object& to) {
@@ -75,6 +77,10 @@ std::vector<SweptTriangle> swept_triangles(const Object& from, const Object& to)
     s.normal = (s.start[1] - s.start[0]).cross(s.start[2] - s.start[0]);
     s.corner_sum = s.start[0] + s.start[1] + s.start[2];
     s.normal_end = (s.end[1] - s.end[0]).cross(s.end[2] - s.end[0]);
+    s.motion = (s.end[0] + s.end[1] + s.end[2]) - s.corner_sum;
+    const Vec3 lo = s.start[0].cwiseMin(s.start[1]).cwiseMin(s.start[2]);
+    const Vec3 hi = s.start[0].cwiseMax(s.start[1]).cwiseMax(s.start[2]);
+    s.size2 = (hi - lo).squaredNorm();
   }
   return out;
 }
@@ -107,14 +113,38 @@ bool points_apart_along(const std::array<Vec3, NA>& a_start, const std::array<Ve
   return d > 0 && d * d > gap * gap * w.squaredNorm();
 }
 
+/// Two axes perpendicular to r (the coordinate axis most nearly perpendicular to r, crossed
+/// with r, and r crossed with that).
+std::array<Vec3, 2> perpendicular_axes(const Vec3& r) {
+  int k = 0;
+  for (int c = 1; c < 3; ++c)
+    if (std::abs(r[c]) < std::abs(r[k])) k = c;
+  const Vec3 w1 = r.cross(Vec3::Unit(k));
+  return {w1, r.cross(w1)};
+}
+
 /// Whether triangles a and b stay more than `gap` apart for the whole step, shown by
 /// points_apart_along() on both normals at the start and the line through the centroids at
 /// the start (any axis is valid); x, y and z are the same test on the triangles' boxes at both
 /// ends (apart_at_both_ends, done first, being cheaper).
+///
+/// When the two move relative to each other by more than their sizes (a fast object crossing
+/// a fine mesh, sideways), the triangle's path sweeps over many others, and each is ahead on
+/// every one of those axes at one end of the step and behind at the other. Two axes
+/// perpendicular to the relative motion r of the centroids then see the pair as nearly static:
+/// a rigid translation by r leaves every projection onto them unchanged, so only the triangles
+/// whose projections overlap — those along the path — remain.
 bool swept_apart(const SweptTriangle& a, const SweptTriangle& b, double gap) {
-  return points_apart_along(a.start, a.end, b.start, b.end, a.normal, gap) ||
-         points_apart_along(a.start, a.end, b.start, b.end, b.normal, gap) ||
-         points_apart_along(a.start, a.end, b.start, b.end, b.corner_sum - a.corner_sum, gap);
+  if (points_apart_along(a.start, a.end, b.start, b.end, a.normal, gap) ||
+      points_apart_along(a.start, a.end, b.start, b.end, b.normal, gap) ||
+      points_apart_along(a.start, a.end, b.start, b.end, b.corner_sum - a.corner_sum, gap))
+    return true;
+  const Vec3 r = b.motion - a.motion;  // 3x the relative motion of the centroids
+  const double sizes = std::sqrt(a.size2) + std::sqrt(b.size2);
+  if (!(r.squaredNorm() > 9 * sizes * sizes)) return false;  // moved less than their sizes
+  const auto w = perpendicular_axes(r);
+  return points_apart_along(a.start, a.end, b.start, b.end, w[0], gap) ||
+         points_apart_along(a.start, a.end, b.start, b.end, w[1], gap);
 }
 
 /// A vertex and a face's corners (NA = 1, NB = 3) or two edges' end points (2, 2), at the
@@ -171,6 +201,23 @@ bool apart_at_both_ends(const AABB& a_start, const AABB& a_end, const AABB& b_st
     if (a_start.lo[k] - b_start.hi[k] > gap && a_end.lo[k] - b_end.hi[k] > gap) return true;
   }
   return false;
+}
+
+/// apart_at_both_ends() along any axis w: a box's projection onto w is its center's ± its half
+/// extents' projection onto |w| (rounding: as in points_apart_along()).
+bool boxes_apart_along(const AABB& a_start, const AABB& a_end, const AABB& b_start, const AABB& b_end,
+                       const Vec3& w, double gap) {
+  const Vec3 aw = w.cwiseAbs();
+  auto range = [&](const AABB& b) {
+    const double c = 0.5 * w.dot(b.lo + b.hi), h = 0.5 * aw.dot(b.hi - b.lo);
+    return std::pair<double, double>{c - h, c + h};
+  };
+  const auto [a0lo, a0hi] = range(a_start);
+  const auto [a1lo, a1hi] = range(a_end);
+  const auto [b0lo, b0hi] = range(b_start);
+  const auto [b1lo, b1hi] = range(b_end);
+  const double d = std::max(std::min(b0lo - a0hi, b1lo - a1hi), std::min(a0lo - b0hi, a1lo - b1hi));
+  return d > 0 && d * d > gap * gap * w.squaredNorm();
 }
 
 /// Results and counters of one unit of work.
@@ -553,9 +600,19 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
       const SweptTriangle& swept_f = swept_i[static_cast<size_t>(f)];
       const AABB& f_start = ends_i.start[static_cast<size_t>(f)];
       const AABB& f_end = ends_i.end[static_cast<size_t>(f)];
+      const Vec3 f_center = 0.5 * (f_start.lo + f_start.hi), f_motion = 0.5 * (f_end.lo + f_end.hi) - f_center;
+      const double f_size2 = (f_start.hi - f_start.lo).squaredNorm();
       const auto subtree_apart = [&](std::int32_t node) {
-        return apart_at_both_ends(f_start, f_end, ends_j.node_start[static_cast<size_t>(node)],
-                                  ends_j.node_end[static_cast<size_t>(node)], apart_gap);
+        const AABB& n_start = ends_j.node_start[static_cast<size_t>(node)];
+        const AABB& n_end = ends_j.node_end[static_cast<size_t>(node)];
+        if (apart_at_both_ends(f_start, f_end, n_start, n_end, apart_gap)) return true;
+        // A triangle moving fast relative to the subtree (by more than its own size): the
+        // axes perpendicular to that motion, as in swept_apart().
+        const Vec3 r = f_motion - 0.5 * ((n_end.lo + n_end.hi) - (n_start.lo + n_start.hi));
+        if (!(r.squaredNorm() > 4 * f_size2)) return false;
+        const auto w = perpendicular_axes(r);
+        return boxes_apart_along(f_start, f_end, n_start, n_end, w[0], apart_gap) ||
+               boxes_apart_along(f_start, f_end, n_start, n_end, w[1], apart_gap);
       };
       bvhs[static_cast<size_t>(j)].query_overlaps(fb, subtree_apart, [&](Index g) {
         if (self && g <= f) return;  // each unordered pair once
