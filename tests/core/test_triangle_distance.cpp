@@ -578,6 +578,42 @@ TEST(TriangleIntersection, ConstructedTouchingCases) {
   EXPECT_EQ(triangle_distance(a, cases[8].b).distance, g);   // coplanar gap at vertex
 }
 
+// The common point reported for touching triangles lies on both. Edge on edge, with
+// coordinates that are not dyadic, the crossing point's clamping interval came out of signs
+// that rounding flipped, and the point was a corner of one triangle 8.7e-4 away from the
+// other (an audit's mesh, triangles of size 1e-3).
+TEST(TriangleIntersection, ContactPointsLieOnBothTriangles) {
+  auto check = [](const Triangle& a, const Triangle& b, double scale) {
+    const TriangleDistanceResult r = triangle_distance(a, b);
+    if (r.kind != TriangleDistanceCase::Intersecting) return false;
+    const double tol = 1e-12 * scale;
+    EXPECT_LE(std::sqrt(point_triangle_distance(r.point_a, a).squared_distance), tol);
+    EXPECT_LE(std::sqrt(point_triangle_distance(r.point_a, b).squared_distance), tol);
+    EXPECT_EQ(r.point_a, r.point_b);
+    return true;
+  };
+  const Triangle a = {Vec3(0.0, 0.0015, 0.001), Vec3(0.002, 0.0, 0.0), Vec3(0.0, 0.0, 0.0017)};
+  const Triangle b = {Vec3(0.0015, 0.0, 0.001), Vec3(0.0015, 0.0005, 0.0005), Vec3(0.001, 0.0005, 0.0)};
+  EXPECT_TRUE(check(a, b, 1e-3));
+  EXPECT_TRUE(check(b, a, 1e-3));
+  // Edges crossing at a point of each, at scales whose coordinates are not dyadic.
+  std::mt19937_64 rng(2025);
+  std::uniform_real_distribution<double> unit(0.2, 0.8);
+  int touching = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    const double scale = trial % 3 == 0 ? 1e-3 : trial % 3 == 1 ? 1e-6 : 1.7;
+    auto pt = [&] { return random_vec(rng, scale); };
+    const Vec3 x = pt(), d = pt() - x, e = pt() - x;
+    const double s = unit(rng), u = unit(rng);
+    // Edge p0p1 of A and edge q0q1 of B both pass (up to rounding) through x.
+    const Triangle ta = {x - s * d, x + (1 - s) * d, x + pt()};
+    const Triangle tb = {x - u * e, x + (1 - u) * e, x + pt()};
+    if (check(ta, tb, scale)) ++touching;
+    check(tb, ta, scale);
+  }
+  EXPECT_GT(touching, 100);  // rounding leaves some apart; enough must touch to mean much
+}
+
 TEST(TriangleIntersection, DegenerateTrianglesAgainstEachOther) {
   const double g = std::ldexp(1.0, -30);
   const Triangle x_axis = {Vec3(-2, 0, 0), Vec3(2, 0, 0), Vec3(0, 0, 0)};
