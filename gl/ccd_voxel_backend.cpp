@@ -45,7 +45,7 @@ CcdVoxelOutput GlCcdVoxelBackend::voxelize(const CcdVoxelInput& in) {
       std::min(limit / sizeof(CcdVoxelRecord), static_cast<std::size_t>(info.max_work_group_count[0]) * local);
   if (in.cooccupancy && std::size_t{in.key_count} * 4 > static_cast<std::size_t>(info.max_ssbo_block_size))
     throw GlError("GlCcdVoxelBackend: the co-occupancy table (" + std::to_string(in.key_count) +
-                  " keys) exceeds GL_MAX_SHADER_STORAGE_BLOCK_SIZE");
+                  " keys) exceeds GL_MAX_SHADER_STORAGE_BLOCK_SIZE; a coarser --grid (or --voronoi=cpu) needs less");
   std::vector<Batch> batches;
   for (std::size_t r = 0; r < n;) {
     Batch b;

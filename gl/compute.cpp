@@ -254,7 +254,8 @@ void StorageBuffer::bind(GLuint binding) const {
   if (static_cast<std::int64_t>(size_) > info_->max_ssbo_block_size) {
     throw GlError("a storage buffer of " + std::to_string(size_) +
                   " bytes exceeds GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" +
-                  std::to_string(info_->max_ssbo_block_size) + " bytes) of " + info_->gl_renderer);
+                  std::to_string(info_->max_ssbo_block_size) + " bytes) of " + info_->gl_renderer +
+                  "; a coarser --grid (or --voronoi=cpu) needs less");
   }
   if (static_cast<GLint>(binding) >= info_->max_ssbo_bindings) {
     throw GlError("storage buffer binding " + std::to_string(binding) +
