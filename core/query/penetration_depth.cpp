@@ -461,23 +461,32 @@ Walk walk_inside(const ObjectView& a, const ObjectView& b, const std::vector<Ind
 }
 
 /// Nearest point of `o`'s surface to p (ties: the smallest triangle id), leaving out the
-/// triangles t with skip(t); distance +inf when every triangle is left out.
+/// triangles t with skip(t); distance +inf when every triangle is left out. With
+/// `stop_at` >= 0 the search stops as soon as it finds a point within stop_at: the distance
+/// returned is then that point's, an upper bound at most stop_at (for a caller that only needs
+/// to know whether the distance exceeds stop_at).
 template <typename Skip>
-std::pair<double, Vec3> nearest_point(const Vec3& p, const ObjectView& o, const Skip& skip) {
+std::pair<double, Vec3> nearest_point(const Vec3& p, const ObjectView& o, const Skip& skip,
+                                      double stop_at = -1) {
   double best_sq = kInfinity;
   Index best_t = kNoIndex;
   Vec3 best_q = p;
+  bool stopped = false;
   AABB box;
   box.lo = box.hi = p;
-  o.bvh->query(box, [&] { return std::sqrt(best_sq); }, [&](Index t, double d2) {
-    if (d2 > best_sq || skip(t)) return;
-    const PointTriangleResult r = point_triangle_distance(p, o.object->triangle(t));
-    if (r.squared_distance < best_sq || (r.squared_distance == best_sq && t < best_t)) {
-      best_sq = r.squared_distance;
-      best_t = t;
-      best_q = r.closest;
-    }
-  });
+  o.bvh->query(
+      box, [&] { return std::sqrt(best_sq); },
+      [&](Index t, double d2) {
+        if (stopped || d2 > best_sq || skip(t)) return;
+        const PointTriangleResult r = point_triangle_distance(p, o.object->triangle(t));
+        if (r.squared_distance < best_sq || (r.squared_distance == best_sq && t < best_t)) {
+          best_sq = r.squared_distance;
+          best_t = t;
+          best_q = r.closest;
+          stopped = stop_at >= 0 && std::sqrt(best_sq) <= stop_at;
+        }
+      },
+      [&](std::int32_t) { return stopped; });
   return {std::sqrt(best_sq), best_q};
 }
 
@@ -814,14 +823,16 @@ PenetrationDepth pair_depth(const std::vector<ObjectView>& views,
     return pd;
   }
   // T: the inside vertex farthest from the other surface (ties: side 0 first, then the
-  // smallest vertex id), and the translation of objects[0] that takes it out.
+  // smallest vertex id), and the translation of objects[0] that takes it out. A vertex's
+  // search stops once it finds a point no farther than the deepest so far: it cannot be
+  // strictly deeper then (max-min; deep overlaps of fine meshes went as n^1.5 without it).
   double best = -1;
   for (int side = 0; side < 2; ++side) {
     const ObjectView& own = side == 0 ? va : vb;
     const ObjectView& other = side == 0 ? vb : va;
     for (Index v : pd.inside_vertices[static_cast<size_t>(side)]) {
       const Vec3& p = own.object->positions[static_cast<size_t>(v)];
-      const auto [d, q] = nearest_point(p, other);
+      const auto [d, q] = nearest_point(p, other, [](Index) { return false; }, best);
       if (d > best) {
         best = d;
         pd.deepest_object = side == 0 ? ia : ib;

@@ -368,6 +368,39 @@ TEST(PenetrationDepth, IcospheresWithinSamplingError) {
   }
 }
 
+// The deepest vertex is the inside vertex farthest from the other surface (ties: objects[0]'s
+// side first, then the smallest vertex id), each distance here from every triangle of the other
+// object: the search's early stop (a vertex no deeper than the deepest so far) changes nothing.
+TEST(PenetrationDepth, DeepestVertexIsTheBruteForceMaxMin) {
+  for (const Vec3& c2 : {Vec3(0.9, 0.1, 0.0), Vec3(0.4, 0.3, -0.2), Vec3(1.2, 0.5, 0.3)}) {
+    const Frame frame = frame_of({make_icosphere(Vec3(0, 0, 0), 1.0, 3, "s1"), make_icosphere(c2, 0.8, 3, "s2")});
+    const auto pd = run_pd(frame);
+    ASSERT_EQ(pd.size(), 1u);
+    ASSERT_EQ(pd[0].status, PdStatus::Ok) << pd_status_name(pd[0].status);
+    double best = -1;
+    int best_side = -1;
+    Index best_vertex = kNoIndex;
+    for (int side = 0; side < 2; ++side) {
+      const Object& own = frame.objects[static_cast<size_t>(side)];
+      const Object& other = frame.objects[static_cast<size_t>(1 - side)];
+      for (Index v : pd[0].inside_vertices[static_cast<size_t>(side)]) {
+        double d2 = kInfinity;
+        for (Index t = 0; t < other.num_triangles(); ++t)
+          d2 = std::min(d2, point_triangle_distance(own.positions[static_cast<size_t>(v)], other.triangle(t)).squared_distance);
+        if (std::sqrt(d2) > best) {
+          best = std::sqrt(d2);
+          best_side = side;
+          best_vertex = v;
+        }
+      }
+    }
+    ASSERT_GE(best_side, 0);
+    EXPECT_EQ(pd[0].deepest_object, best_side);
+    EXPECT_EQ(pd[0].deepest_vertex, best_vertex);
+    EXPECT_NEAR((pd[0].deepest_point - pd[0].nearest_point).norm(), best, 1e-12);
+  }
+}
+
 TEST(PenetrationDepth, ThreadCountDoesNotChangeResults) {
   const Frame frame = frame_of({make_icosphere(Vec3::Zero(), 1.0, 2, "s1"), make_icosphere(Vec3(1.5, 0.2, 0), 0.8, 2, "s2"),
                                 make_box(Vec3(0.5, -0.3, -0.2), Vec3(1.2, 0.5, 0.4), 3, "box")});
