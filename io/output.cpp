@@ -148,10 +148,18 @@ const std::string& host_tag() {
   return tag;
 }
 
+constexpr const char* kJsonName = "results.json";
+constexpr const char* kHdf5Name = "results.h5";
+
+/// `.NAME.tmp-HOST-`, the part of a temporary's name before the process id.
+std::string temp_prefix(const char* final_name) {
+  return "." + std::string(final_name) + ".tmp-" + host_tag() + "-";
+}
+
 /// `.NAME.tmp-HOST-PID`: the host and the process, so that a later run can tell a temporary
 /// left by a process that no longer exists (remove_stale_temporaries()).
 fs::path temp_name(const fs::path& dir, const char* final_name) {
-  return dir / ("." + std::string(final_name) + ".tmp-" + host_tag() + "-" + std::to_string(::getpid()));
+  return dir / (temp_prefix(final_name) + std::to_string(::getpid()));
 }
 
 /// Removes `.results.json.tmp-HOST-PID` and `.results.h5.tmp-HOST-PID` files in `dir` that a
@@ -165,8 +173,8 @@ void remove_stale_temporaries(const fs::path& dir) {
   fs::directory_iterator it(dir, ec), end;
   for (; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();
-    for (const char* final_name : {"results.json", "results.h5"}) {
-      const std::string prefix = "." + std::string(final_name) + ".tmp-" + host_tag() + "-";
+    for (const char* final_name : {kJsonName, kHdf5Name}) {
+      const std::string prefix = temp_prefix(final_name);
       if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
       const std::string digits = name.substr(prefix.size());
       if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
@@ -241,9 +249,6 @@ void sync_file(const fs::path& file) {
   }
   ::close(fd);
 }
-
-constexpr const char* kJsonName = "results.json";
-constexpr const char* kHdf5Name = "results.h5";
 
 }  // namespace
 

@@ -62,7 +62,7 @@ struct SweptTriangle {
   std::array<Vec3, 3> start, end;
   Vec3 normal, corner_sum, normal_end;
   Vec3 motion;         ///< the sum of its corners' displacements over the step (3x the centroid's)
-  double size2 = 0;    ///< squared diagonal of its box at the start
+  double size = 0;     ///< the diagonal of its box at the start
 };
 
 std::vector<SweptTriangle> swept_triangles(const Object& from, const Object& to) {
@@ -80,7 +80,7 @@ std::vector<SweptTriangle> swept_triangles(const Object& from, const Object& to)
     s.motion = (s.end[0] + s.end[1] + s.end[2]) - s.corner_sum;
     const Vec3 lo = s.start[0].cwiseMin(s.start[1]).cwiseMin(s.start[2]);
     const Vec3 hi = s.start[0].cwiseMax(s.start[1]).cwiseMax(s.start[2]);
-    s.size2 = (hi - lo).squaredNorm();
+    s.size = (hi - lo).norm();
   }
   return out;
 }
@@ -140,7 +140,7 @@ bool swept_apart(const SweptTriangle& a, const SweptTriangle& b, double gap) {
       points_apart_along(a.start, a.end, b.start, b.end, b.corner_sum - a.corner_sum, gap))
     return true;
   const Vec3 r = b.motion - a.motion;  // 3x the relative motion of the centroids
-  const double sizes = std::sqrt(a.size2) + std::sqrt(b.size2);
+  const double sizes = a.size + b.size;
   if (!(r.squaredNorm() > 9 * sizes * sizes)) return false;  // moved less than their sizes
   const auto w = perpendicular_axes(r);
   return points_apart_along(a.start, a.end, b.start, b.end, w[0], gap) ||
@@ -600,16 +600,15 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
       const SweptTriangle& swept_f = swept_i[static_cast<size_t>(f)];
       const AABB& f_start = ends_i.start[static_cast<size_t>(f)];
       const AABB& f_end = ends_i.end[static_cast<size_t>(f)];
-      const Vec3 f_center = 0.5 * (f_start.lo + f_start.hi), f_motion = 0.5 * (f_end.lo + f_end.hi) - f_center;
-      const double f_size2 = (f_start.hi - f_start.lo).squaredNorm();
+      const Vec3 f_motion = 0.5 * ((f_end.lo + f_end.hi) - (f_start.lo + f_start.hi));  // its box center's
       const auto subtree_apart = [&](std::int32_t node) {
         const AABB& n_start = ends_j.node_start[static_cast<size_t>(node)];
         const AABB& n_end = ends_j.node_end[static_cast<size_t>(node)];
         if (apart_at_both_ends(f_start, f_end, n_start, n_end, apart_gap)) return true;
-        // A triangle moving fast relative to the subtree (by more than its own size): the
-        // axes perpendicular to that motion, as in swept_apart().
+        // A triangle moving fast relative to the subtree (by more than twice its own size):
+        // the axes perpendicular to that motion, as in swept_apart().
         const Vec3 r = f_motion - 0.5 * ((n_end.lo + n_end.hi) - (n_start.lo + n_start.hi));
-        if (!(r.squaredNorm() > 4 * f_size2)) return false;
+        if (!(r.squaredNorm() > 4 * swept_f.size * swept_f.size)) return false;
         const auto w = perpendicular_axes(r);
         return boxes_apart_along(f_start, f_end, n_start, n_end, w[0], apart_gap) ||
                boxes_apart_along(f_start, f_end, n_start, n_end, w[1], apart_gap);

@@ -490,8 +490,8 @@ std::pair<double, Vec3> nearest_point(const Vec3& p, const ObjectView& o, const 
   return {std::sqrt(best_sq), best_q};
 }
 
-std::pair<double, Vec3> nearest_point(const Vec3& p, const ObjectView& o) {
-  return nearest_point(p, o, [](Index) { return false; });
+std::pair<double, Vec3> nearest_point(const Vec3& p, const ObjectView& o, double stop_at = -1) {
+  return nearest_point(p, o, [](Index) { return false; }, stop_at);
 }
 
 /// max - min of the projections of the points on the unit vector u.
@@ -832,7 +832,7 @@ PenetrationDepth pair_depth(const std::vector<ObjectView>& views,
     const ObjectView& other = side == 0 ? vb : va;
     for (Index v : pd.inside_vertices[static_cast<size_t>(side)]) {
       const Vec3& p = own.object->positions[static_cast<size_t>(v)];
-      const auto [d, q] = nearest_point(p, other, [](Index) { return false; }, best);
+      const auto [d, q] = nearest_point(p, other, best);
       if (d > best) {
         best = d;
         pd.deepest_object = side == 0 ? ia : ib;
