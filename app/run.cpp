@@ -267,9 +267,9 @@ void run(const Config& config) {
       result.time_ms.exact += sw.elapsed_ms();
     }
     if (next_frame) {
-      // The next frame's objects in this frame's order, by name where the files list them
-      // in another order (ccd_counterparts_by_name()).
-      const std::optional<Frame> reordered = ccd_counterparts_by_name(frame, *next_frame);
+      // The next frame's objects in this frame's order: by name where the files list them in
+      // another order, pieces of broken meshes by their vertices (ccd_counterparts()).
+      const std::optional<Frame> reordered = ccd_counterparts(frame, *next_frame);
       const Frame& to = reordered ? *reordered : *next_frame;
       // Stage II for CCD: records on the host, voxels and co-occupancy on the backend.
       sw.restart();

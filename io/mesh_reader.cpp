@@ -106,6 +106,7 @@ std::vector<MeshGroup> split_components(const MeshGroup& group) {
   std::vector<MeshGroup> parts(static_cast<std::size_t>(num_components));
   for (std::size_t c = 0; c < parts.size(); ++c) {
     parts[c].name = group.name + "#" + std::to_string(c);
+    parts[c].origin.mesh = group.name;
   }
   // Vertices in global order; a vertex belongs to its root's component if that has faces.
   std::vector<Index> local(nv, kNoIndex);
@@ -115,6 +116,7 @@ std::vector<MeshGroup> split_components(const MeshGroup& group) {
     MeshGroup& part = parts[static_cast<std::size_t>(c)];
     local[v] = static_cast<Index>(part.positions.size());
     part.positions.push_back(group.positions[v]);
+    part.origin.vertices.push_back(static_cast<Index>(v));
   }
   for (std::size_t i = 0; i < group.faces.size(); ++i) {
     const Face& f = group.faces[i];

@@ -1,5 +1,6 @@
 #pragma once
 // Reading one mesh file into named groups of triangles, keeping the file's own indices.
+#include "core/mesh/topology.hpp"
 #include "core/types.hpp"
 
 #include <filesystem>
@@ -14,6 +15,8 @@ struct MeshGroup {
   std::string name;
   std::vector<Vec3> positions;
   std::vector<Face> faces;
+  /// Set by split_components(): the mesh this component was cut from (core/mesh/topology.hpp).
+  ComponentOrigin origin;
 };
 
 /// Reads OBJ, PLY (ASCII and binary) and ASCII OFF with the project's own index-preserving,
@@ -25,7 +28,8 @@ struct MeshGroup {
 std::vector<MeshGroup> read_mesh_file(const std::filesystem::path& file);
 
 /// Splits one group into its connected components (faces sharing a vertex), in order of
-/// their first face; each component keeps its vertices in file order.
+/// their first face; each component keeps its vertices in file order and records them, as
+/// indices among the group's vertices, in its origin.
 std::vector<MeshGroup> split_components(const MeshGroup& group);
 
 }  // namespace vproxq

@@ -260,6 +260,7 @@ Topology make_topology(const MeshGroup& g) {
   Topology t;
   t.num_vertices = static_cast<Index>(g.positions.size());
   t.faces = g.faces;
+  t.origin = g.origin;
   return t;
 }
 
@@ -515,7 +516,7 @@ Frame SceneSource::load_frame(std::size_t k) const {
       const MeshGroup& g = parts[i];
       const auto nv = static_cast<Index>(g.positions.size());
       if (i < s.previous.size() && s.previous[i]->num_vertices == nv &&
-          s.previous[i]->faces == g.faces) {
+          s.previous[i]->faces == g.faces && s.previous[i]->origin == g.origin) {
         topologies[i] = s.previous[i];
       } else {
         topologies[i] = std::make_shared<const Topology>(make_topology(g));

@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <map>
+#include <set>
 #include <tuple>
 #include <unordered_map>
 
@@ -321,9 +322,62 @@ void finish(std::vector<Hits>& parts, CcdStepResult& out) {
 
 constexpr Index kChunk = 256;  ///< triangles per unit of parallel work
 
+/// Why a piece of a "components" object can lack a counterpart, for the skip reasons.
+constexpr const char* kPieceRule =
+    "pieces are matched by their vertices' indices in their mesh: this one split, merged with "
+    "another, or vertices before it were added or removed";
+
 }  // namespace
 
-std::optional<Frame> ccd_counterparts_by_name(const Frame& from, const Frame& to) {
+namespace {
+
+/// Whether o is a connected component of a mesh ("objects": "components").
+bool is_component(const Object& o) { return o.topology && !o.topology->origin.empty(); }
+
+/// Orders components by what identifies them across frames: static or not, mesh, vertices.
+struct ComponentLess {
+  bool operator()(const Object* a, const Object* b) const {
+    const ComponentOrigin& x = a->topology->origin;
+    const ComponentOrigin& y = b->topology->origin;
+    return std::tie(a->is_static, x.mesh, x.vertices) < std::tie(b->is_static, y.mesh, y.vertices);
+  }
+};
+
+bool same_component(const Object& a, const Object& b) {
+  return a.is_static == b.is_static && a.topology->origin == b.topology->origin;
+}
+
+/// Frames of components: each one's counterpart holds the same vertices of the same mesh.
+/// Nullopt when they are in order already, or when one is listed twice in a frame (two meshes
+/// of one name): then by position, where ccd_participants() checks the origins.
+std::optional<Frame> counterparts_by_origin(const Frame& from, const Frame& to) {
+  std::map<const Object*, size_t, ComponentLess> where;
+  for (size_t k = 0; k < to.objects.size(); ++k)
+    if (!where.emplace(&to.objects[k], k).second) return std::nullopt;
+  std::set<const Object*, ComponentLess> seen;
+  bool in_order = from.objects.size() == to.objects.size();
+  for (size_t i = 0; i < from.objects.size(); ++i) {
+    if (!seen.insert(&from.objects[i]).second) return std::nullopt;
+    const auto it = where.find(&from.objects[i]);
+    in_order = in_order && it != where.end() && it->second == i;
+  }
+  if (in_order) return std::nullopt;
+  Frame aligned;
+  aligned.index = to.index;
+  aligned.files = to.files;
+  aligned.objects.resize(from.objects.size());
+  for (size_t i = 0; i < from.objects.size(); ++i) {
+    const auto it = where.find(&from.objects[i]);
+    if (it != where.end()) {
+      aligned.objects[i] = to.objects[it->second];
+    } else {
+      aligned.objects[i].name = from.objects[i].name;  // no topology: no counterpart
+    }
+  }
+  return aligned;
+}
+
+std::optional<Frame> counterparts_by_name(const Frame& from, const Frame& to) {
   bool same_order = from.objects.size() == to.objects.size();
   for (size_t i = 0; same_order && i < from.objects.size(); ++i)
     same_order = from.objects[i].name == to.objects[i].name;
@@ -355,6 +409,16 @@ std::optional<Frame> ccd_counterparts_by_name(const Frame& from, const Frame& to
   return aligned;
 }
 
+}  // namespace
+
+std::optional<Frame> ccd_counterparts(const Frame& from, const Frame& to) {
+  const auto all_components = [](const Frame& f) {
+    return std::all_of(f.objects.begin(), f.objects.end(), [](const Object& o) { return is_component(o); });
+  };
+  if (!from.objects.empty() && all_components(from) && all_components(to)) return counterparts_by_origin(from, to);
+  return counterparts_by_name(from, to);
+}
+
 CcdParticipants ccd_participants(const Frame& from, const Frame& to) {
   CcdParticipants p;
   std::unordered_map<std::string, size_t> to_names;  // built when first needed
@@ -368,10 +432,21 @@ CcdParticipants ccd_participants(const Frame& from, const Frame& to) {
     }
     const Object& b = to.objects[i];
     if (!b.topology) {
-      p.skipped.push_back({id, "no object named '" + a.name + "' in frame " + std::to_string(to.index)});
+      if (is_component(a))
+        p.skipped.push_back({id, "no piece of '" + a.topology->origin.mesh + "' in frame " + std::to_string(to.index) +
+                                     " holds the same vertices (" + kPieceRule + ")"});
+      else
+        p.skipped.push_back({id, "no object named '" + a.name + "' in frame " + std::to_string(to.index)});
       continue;
     }
-    if (a.name != b.name) {
+    if (is_component(a) || is_component(b)) {
+      // Pieces are matched by their vertices, not by their names (which only number them).
+      if (!is_component(a) || !is_component(b) || !same_component(a, b)) {
+        p.skipped.push_back({id, "'" + b.name + "' of frame " + std::to_string(to.index) +
+                                     " holds other vertices (" + kPieceRule + ")"});
+        continue;
+      }
+    } else if (a.name != b.name) {
       // Objects are matched by position. When this object's name is found at another
       // position of the next frame (and not here), the files list their objects in another
       // order: the vertices here belong to another object. (A name that changes but is not

@@ -4,9 +4,10 @@
 // inter-object and intra-object, with its earliest time of impact.
 //
 // Pipeline: objects are matched by position in the frames' lists (the CLI first reorders the
-// next frame by name where it can: ccd_counterparts_by_name()); an object whose counterpart
-// is missing, whose topology differs or whose name is found at another position of the next
-// frame (objects listed in another order) is skipped for the step (CcdStepResult::skipped).
+// next frame by name, and pieces of broken meshes by their vertices: ccd_counterparts()); an
+// object whose counterpart is missing, whose topology differs, whose name is found at another
+// position of the next frame (objects listed in another order) or, for a piece, whose
+// counterpart holds other vertices, is skipped for the step (CcdStepResult::skipped).
 // Stage I: swept boxes (the box of a triangle's 6 positions, widened by the culling margin
 // below), sweep-and-prune over the swept object boxes, then per object pair a BVH over the
 // swept triangle boxes gives the candidate triangle pairs; a subtree or a pair that a
@@ -54,14 +55,17 @@ struct CcdParticipants {
 };
 CcdParticipants ccd_participants(const Frame& from, const Frame& to);
 
-/// The objects of `to` in `from`'s order, by name: object i of the result is the object of `to`
-/// named like from.objects[i] (files that list their objects in another order, the pieces of
-/// a breaking object renumbered), or, when `to` has no object of that name, an object without
-/// topology (ccd_participants() skips it: no counterpart). Nullopt, for matching by position,
-/// when no object's name is found at another position of `to` (names in the same order, or
-/// names that change with every frame, such as file names) or when a name occurs twice in
-/// either frame.
-std::optional<Frame> ccd_counterparts_by_name(const Frame& from, const Frame& to);
+/// The objects of `to` in `from`'s order: object i of the result is from.objects[i]'s
+/// counterpart in `to`, or an object without topology when it has none (ccd_participants()
+/// skips it). Components of meshes ("objects": "components", ComponentOrigin) are matched by
+/// their origin: the piece of `to` holding the same vertices of the same mesh (pieces are
+/// renumbered when one in front of them breaks, and pieces with equal faces are common, so
+/// names and faces cannot tell them apart). Other objects are matched by name (files that
+/// list their objects in another order). Nullopt, for matching by position, when every object
+/// is at its position already, when a name (or a component) occurs twice in either frame, or,
+/// for names, when no object's name is found at another position of `to` (names that change
+/// with every frame, such as file names).
+std::optional<Frame> ccd_counterparts(const Frame& from, const Frame& to);
 
 /// Swept geometry of a step shared by Stage I, II and III.
 struct CcdSweep {

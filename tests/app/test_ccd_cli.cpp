@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <nlohmann/json.hpp>
 
 #include <fstream>
@@ -208,6 +209,143 @@ TEST(CcdCli, ObjectsAreMatchedAcrossFramesByPositionOrByName) {
   EXPECT_TRUE(ccd["skipped"].empty()) << ccd.dump();
   ASSERT_EQ(ccd["pairs"].size(), 1u) << ccd.dump();
   EXPECT_EQ(ccd["pairs"][0]["objects"], nlohmann::json::parse("[0, 1]"));
+}
+
+
+// "components": pieces are matched by their vertices' indices in the mesh, not by their names
+// "blob#k" (which renumber when a piece in front breaks) nor by their faces (every tetrahedron
+// has the same). Eight tetrahedra, none moving; piece 2 is two tetrahedra sharing a vertex, and
+// in frame 1 that vertex is duplicated, so the piece breaks in two. Matched by name, the pieces
+// behind it were paired with their neighbours, and piece 4 swept through piece 1 (a phantom
+// collision).
+TEST(CcdCli, PiecesOfBrokenMeshesAreMatchedByTheirVertices) {
+  ScratchDir dir;
+  struct Tet {
+    std::vector<Vec3> v;
+    std::vector<Face> f;
+  };
+  auto tet_at = [](double x, double y) {
+    return Tet{{Vec3(x, y, 0), Vec3(x + 0.8, y, 0), Vec3(x, y + 0.8, 0), Vec3(x, y, 0.8)},
+               {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}};
+  };
+  // Piece 1 lies on the way from piece 4 to piece 3: pairing piece 4 with the piece that
+  // takes its number after the break (piece 3) sweeps it through piece 1.
+  const double where[8][2] = {{-6, 6}, {2, 0}, {2, 6}, {0, 0}, {4, 0}, {7, 0}, {10, 0}, {13, 0}};
+  auto slot = [&](int k) { return tet_at(where[k][0], where[k][1]); };
+  // Piece 2 of frame 0: slot 2's tetrahedron and a second one hanging from its vertex 3.
+  const Tet a = slot(2);
+  Tet b{{a.v[3], a.v[3] + Vec3(0.5, 0, 0.3), a.v[3] + Vec3(0, 0.5, 0.3), a.v[3] + Vec3(0, 0, 0.6)},
+        {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}};
+  // One OBJ mesh from pieces; `split` makes piece 2's second tetrahedron use its own copy of
+  // the shared vertex, written right after the first tetrahedron's vertices (`in_front`: the
+  // indices of every later vertex shift by one) or after all others (they keep theirs).
+  auto write = [&](const fs::path& file, bool split, bool in_front) {
+    std::vector<Vec3> v;
+    std::vector<Face> f;
+    auto add = [&](const Tet& t, const std::vector<Index>& ids) {
+      for (const Face& face : t.f) f.push_back({ids[face[0]], ids[face[1]], ids[face[2]]});
+    };
+    Index extra = kNoIndex;
+    std::vector<std::vector<Index>> ids(9);
+    for (int k = 0; k < 8; ++k) {
+      const Tet t = k == 2 ? a : slot(k);
+      for (const Vec3& p : t.v) {
+        ids[k].push_back(static_cast<Index>(v.size()));
+        v.push_back(p);
+      }
+      if (k == 2) {  // b's own vertices 1..3, and the copy of the shared one when split
+        if (split && in_front) {
+          extra = static_cast<Index>(v.size());
+          v.push_back(b.v[0]);
+        }
+        ids[8] = {ids[2][3]};
+        for (int c = 1; c < 4; ++c) {
+          ids[8].push_back(static_cast<Index>(v.size()));
+          v.push_back(b.v[static_cast<size_t>(c)]);
+        }
+      }
+    }
+    if (split && !in_front) {
+      extra = static_cast<Index>(v.size());
+      v.push_back(b.v[0]);
+    }
+    if (split) ids[8][0] = extra;
+    for (int k = 0; k < 8; ++k) {
+      add(k == 2 ? a : slot(k), ids[static_cast<size_t>(k)]);
+      if (k == 2) add(b, ids[8]);
+    }
+    std::ofstream out(file);
+    out.precision(17);
+    out << "o blob\n";
+    for (const Vec3& p : v) out << "v " << p.x() << " " << p.y() << " " << p.z() << "\n";
+    for (const Face& face : f) out << "f " << face[0] + 1 << " " << face[1] + 1 << " " << face[2] + 1 << "\n";
+  };
+  write(dir / "whole.obj", false, false);
+  write(dir / "end.obj", true, false);
+  write(dir / "front.obj", true, true);
+  for (const bool in_front : {false, true}) {
+    SCOPED_TRACE(in_front ? "copy in front of later pieces" : "copy after all vertices");
+    const std::string next = in_front ? "front.obj" : "end.obj";
+    const auto scene = dir.write("s.json", R"({"frames": {"files": ["whole.obj", ")" + next +
+                                               R"("]}, "objects": "components"})");
+    const fs::path out = dir / (in_front ? "out_front" : "out_end");
+    const auto r = vproxq(quote(scene) + " --queries ccd --quiet -o " + quote(out));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const auto ccd = read_json(out / "results.json")["frames"][0]["ccd"];
+    // Nothing moves: no collision, whatever is matched.
+    EXPECT_TRUE(ccd["pairs"].empty()) << ccd.dump();
+    // The broken piece has no counterpart; with the copy in front, neither has any piece
+    // behind it (its vertices' indices changed), otherwise those are matched.
+    std::vector<int> skipped;
+    for (const auto& s : ccd["skipped"]) skipped.push_back(s["object"].get<int>());
+    const std::vector<int> expected = in_front ? std::vector<int>{2, 3, 4, 5, 6, 7} : std::vector<int>{2};
+    EXPECT_EQ(skipped, expected) << ccd.dump();
+    ASSERT_FALSE(ccd["skipped"].empty());
+    EXPECT_NE(ccd["skipped"][0]["reason"].get<std::string>().find("no piece of 'blob' in frame 1 holds the same vertices"),
+              std::string::npos)
+        << ccd.dump();
+  }
+}
+
+
+// Pieces renumbered without breaking (the file lists the mesh's faces in another order) are
+// still matched by their vertices: the same collisions, with frame 0's object ids, as when the
+// faces keep their order.
+TEST(CcdCli, RenumberedPiecesKeepTheirCollisions) {
+  ScratchDir dir;
+  auto tet = [](double x, double y, double z) {
+    std::string v;
+    for (const auto& d : {std::array<double, 3>{0, 0, 0}, {0.8, 0, 0}, {0, 0.8, 0}, {0, 0, 0.8}})
+      v += "v " + std::to_string(x + d[0]) + " " + std::to_string(y + d[1]) + " " + std::to_string(z + d[2]) + "\n";
+    return v;
+  };
+  auto faces = [](int base) {
+    std::string f;
+    for (const auto& t : {std::array<int, 3>{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}})
+      f += "f " + std::to_string(base + t[0] + 1) + " " + std::to_string(base + t[1] + 1) + " " +
+           std::to_string(base + t[2] + 1) + "\n";
+    return f;
+  };
+  // Pieces 0, 1, 2; piece 0 moves through piece 1 in the step.
+  dir.write("f0.obj", "o blob\n" + tet(0, 0, 0) + tet(2, 0, 0) + tet(5, 3, 0) + faces(0) + faces(4) + faces(8));
+  const std::string moved = "o blob\n" + tet(4, 0, 0) + tet(2, 0, 0) + tet(5, 3, 0);
+  dir.write("same.obj", moved + faces(0) + faces(4) + faces(8));
+  dir.write("reordered.obj", moved + faces(8) + faces(4) + faces(0));  // pieces 2, 1, 0 -> #0, #1, #2
+  nlohmann::json got[2];
+  for (int k = 0; k < 2; ++k) {
+    const std::string next = k ? "reordered.obj" : "same.obj";
+    const auto scene = dir.write("s.json", R"({"frames": {"files": ["f0.obj", ")" + next +
+                                               R"("]}, "objects": "components"})");
+    const auto r = vproxq(quote(scene) + " --queries ccd --quiet -o " + quote(dir / ("out" + std::to_string(k))));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    got[k] = read_json(dir / ("out" + std::to_string(k)) / "results.json")["frames"][0]["ccd"];
+    EXPECT_TRUE(got[k]["skipped"].empty()) << got[k].dump();
+    ASSERT_EQ(got[k]["pairs"].size(), 1u) << got[k].dump();
+    EXPECT_EQ(got[k]["pairs"][0]["objects"], nlohmann::json::parse("[0, 1]")) << got[k].dump();
+  }
+  EXPECT_EQ(got[0]["pairs"], got[1]["pairs"]);
+  EXPECT_EQ(got[0]["vf"], got[1]["vf"]);
+  EXPECT_EQ(got[0]["ee"], got[1]["ee"]);
 }
 
 }  // namespace

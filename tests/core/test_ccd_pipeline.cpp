@@ -244,8 +244,8 @@ TEST(CcdPipeline, CounterpartsByNameFollowObjectsListedInAnotherOrder) {
   Frame shuffled = to;
   std::swap(shuffled.objects[0], shuffled.objects[3]);
   std::swap(shuffled.objects[1], shuffled.objects[2]);
-  EXPECT_FALSE(ccd_counterparts_by_name(from, to).has_value());  // already in order
-  const std::optional<Frame> aligned = ccd_counterparts_by_name(from, shuffled);
+  EXPECT_FALSE(ccd_counterparts(from, to).has_value());  // already in order
+  const std::optional<Frame> aligned = ccd_counterparts(from, shuffled);
   ASSERT_TRUE(aligned.has_value());
   const CcdStepResult ref = continuous_collisions_brute_force(from, to);
   EXPECT_FALSE(ref.vf.empty() && ref.ee.empty());
@@ -255,7 +255,7 @@ TEST(CcdPipeline, CounterpartsByNameFollowObjectsListedInAnotherOrder) {
   // A name missing from the next frame: that object is skipped, the others are matched.
   Frame fewer = shuffled;
   fewer.objects.erase(fewer.objects.begin());  // to's object 3
-  const std::optional<Frame> partial = ccd_counterparts_by_name(from, fewer);
+  const std::optional<Frame> partial = ccd_counterparts(from, fewer);
   ASSERT_TRUE(partial.has_value());
   const CcdStepResult r = continuous_collisions(from, *partial, CcdOptions{2, nullptr});
   ASSERT_EQ(r.skipped.size(), 1u);
@@ -265,13 +265,13 @@ TEST(CcdPipeline, CounterpartsByNameFollowObjectsListedInAnotherOrder) {
   // A name given twice: no matching by name (objects are then matched by position).
   Frame twice = shuffled;
   twice.objects[1].name = twice.objects[0].name;
-  EXPECT_FALSE(ccd_counterparts_by_name(from, twice).has_value());
+  EXPECT_FALSE(ccd_counterparts(from, twice).has_value());
 
   // Names that change with every frame (each file's name) and are found nowhere else: matched
   // by position, nothing skipped.
   Frame renamed = to;
   for (Object& o : renamed.objects) o.name += "-next";
-  EXPECT_FALSE(ccd_counterparts_by_name(from, renamed).has_value());
+  EXPECT_FALSE(ccd_counterparts(from, renamed).has_value());
 }
 
 TEST(CcdPipeline, IncidentPairsAreExcludedButNeighboursAreTested) {
