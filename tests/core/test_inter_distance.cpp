@@ -4,6 +4,7 @@
 #include "core/query/inter_distance.hpp"
 #include "support/expect_same.hpp"
 #include "support/random_scene.hpp"
+#include "support/self_meshes.hpp"
 
 #include <gtest/gtest.h>
 
@@ -265,6 +266,31 @@ TEST(ObjectBroadPhase, CrowdOfSmallObjects) {
     EXPECT_LT(sum_u / static_cast<double>(frame.objects.size()), side / 10) << "seed " << seed;
     test::expect_same_inter(inter_object_distance(frame, {2}), ref, "crowd seed " + std::to_string(seed));
   }
+}
+
+// Long parallel sticks side by side (every x-interval overlaps every other, every box's
+// farthest corner is a stick's length away): U_i is at most the distance to a neighbouring
+// stick's surface, found by walking to the nearest box, so the PNS holds the neighbours and
+// not most of the sticks (which made Stage I quadratic in their number); the answers equal
+// brute force.
+TEST(ObjectBroadPhase, LongParallelSticksKeepLocalBounds) {
+  Frame frame;
+  const int side = 12;
+  for (int a = 0; a < side; ++a)
+    for (int b = 0; b < side; ++b) {
+      const double y = a + 0.01 * ((a * 7 + b * 3) % 5), z = b + 0.01 * ((a + b * 5) % 7);
+      frame.objects.push_back(test::make_object({{0, y, z}, {1000, y + 0.1, z}, {1000, y + 0.05, z + 0.05}, {0, y + 0.1, z + 0.05}},
+                                          {{0, 1, 2}, {0, 2, 3}}, "s" + std::to_string(a * side + b)));
+    }
+  const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
+  const ObjectBroadPhase bp = object_broad_phase(frame, boxes, 2);
+  const auto ref = inter_object_distance_brute_force(frame);
+  for (size_t i = 0; i < frame.objects.size(); ++i) {
+    EXPECT_GE(bp.upper_bound[i], ref.per_object[i].distance) << "stick " << i;
+    EXPECT_LT(bp.upper_bound[i], 1.5) << "stick " << i;  // a neighbour is about 1 away
+    EXPECT_LE(bp.pns[i].size(), 12u) << "stick " << i;
+  }
+  test::expect_same_inter(inter_object_distance(frame, {2}), ref, "sticks");
 }
 
 TEST(OverlappingBoxPairs, EqualsAllPairs) {
