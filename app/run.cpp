@@ -239,7 +239,11 @@ void run(const Config& config) {
     if (want_distance || want_pd) {
       sw.restart();
       const FrameBoxes boxes = FrameBoxes::compute(frame, info.threads);
-      const ObjectBroadPhase stage1 = object_broad_phase(frame, boxes, info.threads);
+      // Stage I's upper bounds and PNS serve the inter-object distance and Stage II's bands;
+      // the intersecting pairs and PD alone need only the boxes.
+      const ObjectBroadPhase stage1 = want_distance || voronoi.backend
+                                          ? object_broad_phase(frame, boxes, info.threads)
+                                          : ObjectBroadPhase{};
       result.time_ms.aabb = sw.elapsed_ms();
       InterDistanceOptions opts{info.threads, nullptr};
       VoronoiBounds bounds;
