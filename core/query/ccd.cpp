@@ -592,14 +592,30 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
   out.aabb_ms = sw.elapsed_ms();
   sw.restart();
 
-  // Units of work: (object pair, chunk of the first object's triangles).
+  // Units of work: (object pair, chunk of the first object's triangles that can meet the
+  // second: all of them within one object, else those whose swept boxes overlap the second
+  // object's, found through the first one's BVH). Scanning all of them made every small object
+  // beside a big one of lower id cost the big one's size: 20,000 tetrahedra on a 161,312-triangle
+  // floor listed first took 10.3 s of exact stage against 0.9 s with the floor listed last.
+  std::vector<std::vector<Index>> near(object_pairs.size());
+  parallel_for(object_pairs.size(), threads, [&](size_t p) {
+    const auto [i, j] = object_pairs[p];
+    if (i == j) return;
+    bvhs[static_cast<size_t>(i)].query_overlaps(sweep.objects[static_cast<size_t>(j)],
+                                                [](std::int32_t) { return false; },
+                                                [&](Index f) { near[p].push_back(f); });
+    std::sort(near[p].begin(), near[p].end());
+  });
   struct Task {
-    Index i, j, first, last;
+    Index i, j;
+    std::size_t pair;    ///< index into object_pairs (and near)
+    Index first, last;  ///< within object i's triangles (i == j), else within near[pair]
   };
   std::vector<Task> tasks;
-  for (const auto& [i, j] : object_pairs) {
-    const Index n = from.objects[static_cast<size_t>(i)].num_triangles();
-    for (Index t = 0; t < n; t += kChunk) tasks.push_back({i, j, t, std::min(n, t + kChunk)});
+  for (size_t p = 0; p < object_pairs.size(); ++p) {
+    const auto [i, j] = object_pairs[p];
+    const Index n = i == j ? from.objects[static_cast<size_t>(i)].num_triangles() : static_cast<Index>(near[p].size());
+    for (Index t = 0; t < n; t += kChunk) tasks.push_back({i, j, p, t, std::min(n, t + kChunk)});
   }
   const Tester tester(from, to);
   const CcdVoxelCulling* voxels = opts.voxels;
@@ -636,7 +652,6 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
       box.extend(vb[static_cast<size_t>(f[2])]);
       return box;
     };
-    const AABB& box_j = sweep.objects[static_cast<size_t>(j)];
     const bool self = i == j;
     Hits& hits = parts[k];
     // Separation that rules out a report: the kernel reports a pair whose primitives come
@@ -663,9 +678,9 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
       tester.vertex_face(ov, v, og, g, hits);
     };
 
-    for (Index f = task.first; f < task.last; ++f) {
+    for (Index q = task.first; q < task.last; ++q) {
+      const Index f = self ? q : near[task.pair][static_cast<size_t>(q)];
       const AABB& fb = tb_i[static_cast<size_t>(f)];
-      if (!self && !boxes_overlap(fb, box_j)) continue;
       if (voxels && !self && !voxels->keeps(i, f)) {
         ++hits.counters.culled_triangles;
         continue;
