@@ -43,6 +43,9 @@ std::vector<std::pair<std::string, Frame>> scenes() {
     out.emplace_back("irregular seed " + std::to_string(seed),
                      frame_of({test::make_irregular_mesh(rng)}));
   }
+  // A tetrahedron (no triangle has an answer) beside two tetrahedra in one object (every
+  // triangle's answer is in the other one).
+  out.emplace_back("tetrahedra", frame_of({test::make_tetrahedra(1, 0, "one"), test::make_tetrahedra(2, 1.5, "two")}));
   return out;
 }
 
@@ -265,8 +268,9 @@ void for_each_recorded_run(const Check& check) {
 }
 
 // Only triangles whose 2-ring bound exceeds δ get samples (Stage II cannot lower the others'
-// D_u); the others keep D_u = 2-ring bound and D_l = -inf. Both kinds occur, and Stage II
-// still culls candidates on these scenes.
+// D_u), and that have a non-adjacent triangle at all (not a tetrahedron's faces); the others
+// keep D_u = 2-ring bound and D_l = -inf. Both kinds occur, and Stage II still culls
+// candidates on these scenes.
 TEST(IntraStage2, OnlyTrianglesWhoseRing2BoundExceedsDeltaAreSampled) {
   std::uint64_t sampled = 0, unsampled = 0, culled = 0;
   for_each_recorded_run([&](const Frame& frame, const FrameBoxes& boxes, const std::vector<std::vector<double>>& ring2,
@@ -281,7 +285,8 @@ TEST(IntraStage2, OnlyTrianglesWhoseRing2BoundExceedsDeltaAreSampled) {
       const size_t n = ring2[i].size();
       const bool has_pairs = n >= 2;
       for (size_t t = 0; t < n; ++t) {
-        const bool want = has_pairs && ring2[i][t] > vb.delta;
+        const bool want = has_pairs && ring2[i][t] > vb.delta &&
+                          test::has_non_adjacent(frame.objects[i], static_cast<Index>(t));
         const bool got = has_pairs && has_samples[global + t] != 0;
         ASSERT_EQ(got, want) << "object " << i << " triangle " << t;
         if (!want) {

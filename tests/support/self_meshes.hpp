@@ -94,4 +94,31 @@ inline Object make_irregular_mesh(Rng& rng, const std::string& name = "irregular
   return o;
 }
 
+/// Closed tetrahedra, `count` of them in one object, `spacing` apart along x: with one, every
+/// triangle shares a vertex with every other (no triangle has an answer).
+inline Object make_tetrahedra(int count, double spacing, const std::string& name = "tets") {
+  std::vector<Vec3> v;
+  std::vector<Face> f;
+  for (int k = 0; k < count; ++k) {
+    const auto b = static_cast<Index>(v.size());
+    const double x = spacing * k;
+    v.insert(v.end(), {Vec3(x, 0, 0), Vec3(x + 1, 0, 0), Vec3(x, 1, 0), Vec3(x, 0, 1)});
+    f.insert(f.end(), {{b, b + 2, b + 1}, {b, b + 1, b + 3}, {b, b + 3, b + 2}, {b + 1, b + 2, b + 3}});
+  }
+  return make_object(std::move(v), std::move(f), name);
+}
+
+/// Whether triangle t of o has a triangle sharing no vertex with it (brute force).
+inline bool has_non_adjacent(const Object& o, Index t) {
+  const auto& faces = o.topology->faces;
+  const Face& a = faces[static_cast<size_t>(t)];
+  for (const Face& b : faces) {
+    bool shared = false;
+    for (const Index x : a)
+      for (const Index y : b) shared = shared || x == y;
+    if (!shared) return true;
+  }
+  return false;
+}
+
 }  // namespace vproxq::test
