@@ -131,11 +131,12 @@ ObjectBroadPhase object_broad_phase(const Frame& frame, const FrameBoxes& boxes,
     // object's length away: without this walk, U_i held most of N parallel sticks, and so did
     // the PNS and the farthest-corner search below (Stage I was quadratic, 16 s at N = 20,000).
     Index closest = kNoIndex;
-    double closest_d2 = kInfinity;
-    tree.query(bi, [&] { return std::sqrt(closest_d2); }, [&](Index t, double d2) {
+    double closest_d2 = kInfinity, closest_d = kInfinity;
+    tree.query(bi, [&] { return closest_d; }, [&](Index t, double d2) {
       const Index j = live[static_cast<size_t>(t)];
       if (j != i && (d2 < closest_d2 || (d2 == closest_d2 && j < closest))) {
         closest_d2 = d2;
+        closest_d = std::sqrt(d2);
         closest = j;
       }
     });

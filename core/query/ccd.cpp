@@ -327,10 +327,6 @@ constexpr const char* kPieceRule =
     "pieces are matched by their vertices' indices in their mesh: this one split, merged with "
     "another, or vertices before it were added or removed";
 
-}  // namespace
-
-namespace {
-
 /// Whether o is a connected component of a mesh ("objects": "components").
 bool is_component(const Object& o) { return o.topology && !o.topology->origin.empty(); }
 
