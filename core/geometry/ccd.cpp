@@ -176,6 +176,99 @@ bool excluded_along_box_directions(const double F[8][3], const double eps[3], co
   return unit_max(w2) > 0 && excludes(w2, F, eps, fmax);
 }
 
+// ---- Exclusion along a direction that moves with t -------------------------------------------
+//
+// The tests above fix one w for the whole box. When the primitives turn during the step (a
+// cloth roll that rotates, with its turns 1e-6 of an edge apart), the image of a box is a
+// bow tie: at every t it is a thin sliver beside the origin, but the slivers turn with t and
+// the hull of the 8 corners (all a fixed w can use) takes in the origin unless the box is tiny
+// in t and in u, v together: some 10^5 boxes along the curve of near-roots. So w may move
+// too: w(s) = (1 - s) wa + s wb over the box's t range (s in [0, 1]), wa proposed by the
+// corners at the box's t0 and wb by those at its t1, in the same three ways as above.
+//   For fixed (u, v), F is affine in t (the points move linearly; u and v multiply them), so
+// F(s) = (1 - s) F0 + s F1 with F0, F1 the corner values at the same (u, v); and for fixed t,
+// F is affine in (u, v) jointly (no uv term in either kind), so w(s) . F over the box's
+// (u, v) range is smallest at one of its 4 (u, v) corners. At a corner, w(s) . F(s) is the
+// quadratic with Bernstein coefficients wa . F0, (wa . F1 + wb . F0) / 2, wb . F1 on [0, 1],
+// which lies within the range of its coefficients. So when, for all 4 corners, all three
+// coefficients exceed 0 (or all are below 0) by their rounding bound, the box holds no root.
+//   Rounding: each dot product is bounded as in excludes() with E taken from the larger
+// |w_k| of wa and wb (both scaled to max |w_k| = 1). The middle coefficient is tested as
+// fl(x + y) > 2E: with x, y within E of the exact products, and fl(x + y) <= (x + y)(1 + u),
+// the exact sum is above 2E / (1 + u) - 2E / (1 + 2^-40) > 0 (E carries that factor).
+
+/// The sum of the 4 corners (u, v) of one t face (tbit 0 or 1), and their spreads along u and
+/// along v (the change over the 2 corner pairs that differ in that parameter).
+inline void face_directions(const double F[8][3], int tbit, double w[3][3]) {
+  double sum[3] = {0, 0, 0}, du[3] = {0, 0, 0}, dv[3] = {0, 0, 0};
+  for (int c = 0; c < 4; ++c) {
+    const int i = tbit | (c << 1);
+    for (int k = 0; k < 3; ++k) {
+      sum[k] += F[i][k];
+      if (c & 1) du[k] += F[i][k] - F[i & ~2][k];
+      if (c & 2) dv[k] += F[i][k] - F[i & ~4][k];
+    }
+  }
+  const double su = unit_max(du), sv = unit_max(dv);
+  for (int k = 0; k < 3; ++k) w[0][k] = sum[k];
+  // w1: the sum without its component along the larger spread.
+  const double* a = su >= sv ? du : dv;
+  const double aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+  const double along = aa > 0 ? (sum[0] * a[0] + sum[1] * a[1] + sum[2] * a[2]) / aa : 0;
+  for (int k = 0; k < 3; ++k) w[1][k] = sum[k] - along * a[k];
+  // w2: the normal of the face's image.
+  w[2][0] = du[1] * dv[2] - du[2] * dv[1];
+  w[2][1] = du[2] * dv[0] - du[0] * dv[2];
+  w[2][2] = du[0] * dv[1] - du[1] * dv[0];
+}
+
+/// Whether w(s) = (1 - s) wa + s wb (each scaled by unit_max) separates the box's image from 0
+/// (see above).
+/// `ends_apart` is set when both ends (every b0 and b2) were separated and only the middle
+/// coefficients failed: the turning during the box's t range is what keeps it.
+inline bool excludes_moving(const double wa[3], const double wb[3], const double F[8][3], const double eps[3],
+                            const double fmax[3], bool& ends_apart) {
+  double bound = 0;
+  for (int k = 0; k < 3; ++k)
+    bound += std::max(std::abs(wa[k]), std::abs(wb[k])) * (eps[k] + kDotRounding * fmax[k]);
+  bound = bound * (1 + 0x1p-40) + 0x1p-1070;
+  const double twice = 2 * bound;
+  bool positive = true, negative = true, ends_positive = true, ends_negative = true;
+  for (int c = 0; c < 4 && (ends_positive || ends_negative); ++c) {
+    const double* f0 = F[c << 1];
+    const double* f1 = F[(c << 1) | 1];
+    const double b0 = (wa[0] * f0[0] + wa[1] * f0[1]) + wa[2] * f0[2];
+    const double b2 = (wb[0] * f1[0] + wb[1] * f1[1]) + wb[2] * f1[2];
+    const double b1 = ((wa[0] * f1[0] + wa[1] * f1[1]) + wa[2] * f1[2]) + ((wb[0] * f0[0] + wb[1] * f0[1]) + wb[2] * f0[2]);
+    ends_positive = ends_positive && b0 > bound && b2 > bound;
+    ends_negative = ends_negative && b0 < -bound && b2 < -bound;
+    positive = positive && ends_positive && b1 > twice;
+    negative = negative && ends_negative && b1 < -twice;
+  }
+  ends_apart = ends_apart || ends_positive || ends_negative;
+  return positive || negative;
+}
+
+/// The moving-direction test with the three directions proposed by the box's two t faces;
+/// `ends_apart` as in excludes_moving() for any of them.
+bool excluded_along_moving_directions(const double F[8][3], const double eps[3], const double fmax[3],
+                                      bool& ends_apart) {
+  double wa[3][3], wb[3][3];
+  face_directions(F, 0, wa);
+  face_directions(F, 1, wb);
+  for (int i = 0; i < 3; ++i) {
+    if (!(unit_max(wa[i]) > 0) || !(unit_max(wb[i]) > 0)) continue;
+    // Any wa and wb are valid; turned the same way, they can agree on a side.
+    if (wa[i][0] * wb[i][0] + wa[i][1] * wb[i][1] + wa[i][2] * wb[i][2] < 0)
+      for (int k = 0; k < 3; ++k) wb[i][k] = -wb[i][k];
+    if (excludes_moving(wa[i], wb[i], F, eps, fmax, ends_apart)) return true;
+  }
+  return false;
+}
+
+/// Boxes a query evaluates before it also tries the moving directions.
+constexpr std::uint32_t kMovingAfter = 64;
+
 CcdResult conservative_hit(double t, std::uint32_t boxes) {
   CcdResult r;
   r.collides = true;
@@ -256,6 +349,10 @@ CcdResult solve(Kind kind, const std::array<Vec3, 4>& start, const std::array<Ve
     }
     if (excluded) continue;
     if (excluded_along_box_directions(F, q.eps, fmax)) continue;
+    // The moving directions cost about as much again as the rest of a box; queries decided
+    // within kMovingAfter boxes (nearly all) do without them.
+    bool ends_apart = false;
+    if (result.boxes > kMovingAfter && excluded_along_moving_directions(F, q.eps, fmax, ends_apart)) continue;
     if (inside) {
       best = b.t0;  // b.t0 < best, checked above
       continue;
@@ -266,7 +363,7 @@ CcdResult solve(Kind kind, const std::array<Vec3, 4>& start, const std::array<Ve
     // c | bit differ only in parameter `dim` (bit = 1 << dim).
     const double width[3] = {b.t1 - b.t0, b.u1 - b.u0, b.v1 - b.v0};
     int split = -1;
-    if (b.t1 > best && width[0] > kMinWidth) {
+    if ((b.t1 > best || ends_apart) && width[0] > kMinWidth) {
       split = 0;
     } else {
       double best_var = -1;

@@ -13,7 +13,9 @@
 // root. Since F over a box lies in the convex hull of its corner values, the same holds along
 // any direction: a few directions taken from the corners (ccd.cpp) discard the boxes of
 // near-degenerate queries (sliding contact, edges that become parallel or coincide) that no
-// coordinate range can, long before the boxes are tiny. Boxes are bisected depth first,
+// coordinate range can, long before the boxes are tiny; after a few boxes, so do directions
+// that move linearly with t (primitives that stay close and parallel while they turn: ccd.cpp).
+// Boxes are bisected depth first,
 // earlier t first; a box whose whole widened range lies within the tolerance cube [-δ, δ]^3
 // is a hit, and the reported TOI is the smallest lower t of the hits (boxes that start later
 // than the best hit so far are dropped unexamined).
