@@ -22,12 +22,14 @@
 // of one object sharing a vertex. Vertices used by no face take no part.
 //
 // Culling margin: the kernel may report a pair whose primitives come within its tolerance δ
-// (never more than ccd_max_tolerance() for the coordinates of the two objects involved); each
-// pair of objects gets that plus rounding_slack() as its margin (CcdSweep::pair_margin(); the
-// primitive box tests widen by it, the separating-axis tests ask for twice that, as the
-// kernel's per-axis δ allows a Euclidean gap of sqrt(3) δ), triangle boxes are widened by a
-// per-object share of it (ccd_tolerance_share()), and Stage II by the step's largest margin,
-// so culling never removes a pair the kernel would report and the results equal the brute force — with one documented exception: a
+// (never more than ccd_max_tolerance() for the coordinates of the query's 8 points); each pair
+// of triangles gets that, for the box of their 12 positions, plus rounding_slack() as its
+// margin (ccd_margin_between() of their swept boxes; the primitive box tests widen by it, the
+// separating-axis tests ask for twice that, as the kernel's per-axis δ allows a Euclidean gap
+// of sqrt(3) δ; a triangle against a BVH subtree uses the subtree's box). Triangle boxes are
+// widened by their own share of it (ccd_tolerance_share()), and Stage II by the step's largest
+// margin, so culling never removes a pair the kernel would report and the results equal the
+// brute force — with one documented exception: a
 // test that stops at the kernel's box limit (counters.limit_hits) is reported without a
 // proximity guarantee, so brute force could report such a pair where culling (correctly: it
 // cannot collide) removed it.
@@ -74,15 +76,14 @@ struct CcdSweep {
   /// objects (pair_margin()). Stage II widens its prisms by it.
   double margin = 0;
   /// Per object: its swept box (both frames, all vertices; not widened), the largest
-  /// coordinate magnitude in it, and how much its triangle boxes are widened
-  /// (ccd_tolerance_share(), so that two objects' widenings add up to at least their
-  /// pair_margin() wherever their boxes come that close).
+  /// coordinate magnitude in it, and the most any of its triangle boxes is widened (each by
+  /// its own ccd_tolerance_share(), so that two triangles' widenings add up to at least their
+  /// ccd_margin_between() wherever their boxes come that close).
   std::vector<AABB> raw_objects;
   std::vector<double> magnitudes;
   std::vector<double> widening;
-  /// The culling margin of a pair of objects: ccd_max_tolerance() for the coordinates of the
-  /// two objects (the kernel's δ of any query made of their primitives is at most that) plus
-  /// rounding_slack() of their magnitude. One far-away object then does not widen the
+  /// The culling margin of a pair of objects: ccd_margin_between() of their swept boxes (it
+  /// bounds the margins of all their triangle pairs). One far-away object does not widen the
   /// margins of the others.
   double pair_margin(Index i, Index j) const;
   /// [object][triangle] swept boxes (widened by the object's `widening`), empty for skipped
@@ -94,6 +95,11 @@ struct CcdSweep {
   std::vector<std::vector<AABB>> vertices;
   static CcdSweep compute(const Frame& from, const Frame& to, int threads);
 };
+
+/// The culling margin of two point sets with boxes a and b: ccd_max_tolerance() for the box
+/// of both (its largest side and coordinate magnitude; the kernel's δ of any query whose
+/// points lie in a or b is at most that) plus rounding_slack() of that magnitude.
+double ccd_margin_between(const AABB& a, const AABB& b);
 
 /// The whole pipeline: Stage I, Stage II when opts.voxels is set, Stage III.
 /// Deterministic: the result does not depend on the thread count.

@@ -206,12 +206,12 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
   for (size_t i = 0; i < n; ++i) {
     first_[i + 1] = first_[i] + (part[i] ? from.objects[i].num_triangles() : 0);
     if (part[i] && !sweep.objects[i].empty()) {
-      // The object's triangle boxes are widened by its own share of the margin; the prisms
-      // below by the step's whole margin: the grid covers the larger.
-      AABB box = sweep.objects[i];
-      const double more = std::max(0.0, sweep.margin - sweep.widening[i]);
-      box.lo.array() -= more;
-      box.hi.array() += more;
+      // The object's triangle boxes are widened by their own shares of the margin; the
+      // prisms below by the step's whole margin: the grid covers both.
+      AABB box = sweep.raw_objects[i];
+      box.lo.array() -= sweep.margin;
+      box.hi.array() += sweep.margin;
+      box.extend(sweep.objects[i]);
       scene.extend(box);
     }
   }

@@ -156,6 +156,50 @@ TEST(CcdPipeline, AFastSidewaysPassThroughAFineSheetTestsOnlyAlongThePath) {
   EXPECT_LT(got.counters.elementary_tests(), 16 * (ref.vf.size() + ref.ee.size()));
 }
 
+// Two layers of a sheet 1e-5 apart (a cloth folded flat, or stacked): the kernel's δ for
+// queries of two nearby triangles is about 1e-6 of their size (edges of 1 here), so the
+// layers are far outside it and every pair between them is culled. A margin taken from the
+// whole object (1e-6 of its size, 10) covered the gap, and every triangle pair of the two
+// layers that overlap was tested.
+TEST(CcdPipeline, LayersCloserThanTheObjectsMarginButApartAreCulled) {
+  const int n = 10;
+  std::vector<Vec3> p;
+  std::vector<Face> faces;
+  for (int layer = 0; layer < 2; ++layer) {
+    const Index base = static_cast<Index>(p.size());
+    for (int y = 0; y <= n; ++y)
+      for (int x = 0; x <= n; ++x) p.emplace_back(x, y, layer * 1e-5);
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        const Index a = base + y * (n + 1) + x, b = a + 1, c = a + n + 1, d = c + 1;
+        faces.push_back({a, b, d});
+        faces.push_back({a, d, c});
+      }
+  }
+  const size_t per_layer = p.size() / 2;
+  Frame from, to;
+  from.objects = {test::make_object(p, faces, "stack")};
+  to.objects = from.objects;
+  to.index = 1;
+  for (size_t v = per_layer; v < p.size(); ++v) to.objects[0].positions[v].x() += 0.3;  // the top layer slides
+  const CcdStepResult ref = continuous_collisions_brute_force(from, to);
+  EXPECT_EQ(ref.counters.limit_hits, 0u);
+  const CcdStepResult got = continuous_collisions(from, to, CcdOptions{2, nullptr});
+  expect_same_ccd(got, ref);
+  // The same step with each layer alone: no test between the layers is left.
+  std::uint64_t alone = 0;
+  for (int layer = 0; layer < 2; ++layer) {
+    std::vector<Face> f(faces.begin() + layer * 2 * n * n, faces.begin() + (layer + 1) * 2 * n * n);
+    Frame a, b;
+    a.objects = {test::make_object(p, f, "layer")};
+    b.objects = a.objects;
+    b.objects[0].positions = to.objects[0].positions;
+    b.index = 1;
+    alone += continuous_collisions(a, b, CcdOptions{2, nullptr}).counters.elementary_tests();
+  }
+  EXPECT_EQ(got.counters.elementary_tests(), alone);
+}
+
 // Vertices used by no face take no part: an unused vertex that one frame's file adds (or
 // lacks) is no topology change, and the step's answer is that of the same step without it.
 TEST(CcdPipeline, AnUnusedVertexInOneFrameOnlyChangesNothing) {
