@@ -19,31 +19,6 @@
 namespace vproxq {
 namespace {
 
-// Deduplication by ownership: a vertex is owned by its smallest incident triangle, an edge by
-// its smallest incident triangle. A candidate triangle pair (f, g) tests vertex v of f against
-// face g only if f owns v, and edge e of f against edge e' of g only if f owns e and g owns e'.
-// So each primitive pair is tested from exactly one triangle pair. No pair that can be
-// reported is lost: if the kernel can report (v, g), v's swept path comes within the margin
-// of g's swept prism, and v's path lies in the swept prism (and box) of every triangle using
-// v — in particular its owner's — so the culling keeps (owner(v), g); likewise for edges.
-struct Ownership {
-  std::vector<Index> vertex;  ///< owner triangle per vertex (kNoIndex: used by no face)
-  std::vector<Index> edge;    ///< owner triangle per edge id
-};
-
-Ownership ownership(const Topology& topo) {
-  const Adjacency& adj = adjacency(topo);
-  Ownership o;
-  o.vertex.assign(static_cast<size_t>(topo.num_vertices), kNoIndex);
-  for (Index v = 0; v < topo.num_vertices; ++v) {
-    const IndexSpan tris = adj.vertex_triangles(v);
-    if (!tris.empty()) o.vertex[static_cast<size_t>(v)] = tris[0];
-  }
-  o.edge.resize(adj.edges().size());
-  for (size_t e = 0; e < adj.edges().size(); ++e) o.edge[e] = adj.edge_triangles(static_cast<Index>(e))[0];
-  return o;
-}
-
 bool in_face(Index v, const Face& f) { return f[0] == v || f[1] == v || f[2] == v; }
 
 /// Whether entry k of a triangle's corners or edge ids repeats an earlier one (a face with a
@@ -54,6 +29,89 @@ bool repeats_earlier(const std::array<Index, 3>& a, size_t k) {
 
 bool share_endpoint(const std::array<Index, 2>& a, const std::array<Index, 2>& b) {
   return a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1];
+}
+
+// Deduplication by ownership: a vertex is owned by one of its incident triangles, an edge by
+// one of its incident triangles (any rule works; the pipeline prefers the triangle whose
+// busiest corner has the fewest incident triangles, then the smaller id; the brute force takes
+// the smallest id). A candidate triangle pair (f, g) tests vertex v of f against face g only if
+// f owns v, and edge e of f against edge e' of g only if f owns e and g owns e'. So each
+// primitive pair is tested from exactly one triangle pair. No pair that can be reported is
+// lost: if the kernel can report (v, g), v's swept path comes within the margin of g's swept
+// prism, and v's path lies in the swept prism (and box) of every triangle using v — in
+// particular its owner's — so the culling keeps (owner(v), g); likewise for edges.
+//   The preference keeps the rim vertices and rim edges of a fan (the cap of a cylinder with
+// thousands of segments) with the triangles beside it, so the fan's triangles own only
+// primitives that contain its hub; see pivots() for what that buys.
+struct Ownership {
+  std::vector<Index> vertex;  ///< owner triangle per vertex (kNoIndex: used by no face)
+  std::vector<Index> edge;    ///< owner triangle per edge id
+};
+
+/// `prefer_quiet`: the pipeline's rule above; else the smallest id.
+Ownership ownership(const Topology& topo, bool prefer_quiet = false) {
+  const Adjacency& adj = adjacency(topo);
+  std::vector<std::size_t> busiest;
+  if (prefer_quiet) {
+    busiest.resize(static_cast<size_t>(topo.num_triangles()));
+    for (size_t t = 0; t < busiest.size(); ++t)
+      for (const Index v : topo.faces[t]) busiest[t] = std::max(busiest[t], adj.vertex_triangles(v).size());
+  }
+  auto pick = [&](IndexSpan tris) {
+    Index best = tris[0];
+    if (prefer_quiet)
+      for (const Index t : tris) {
+        const size_t a = busiest[static_cast<size_t>(t)], b = busiest[static_cast<size_t>(best)];
+        if (a < b || (a == b && t < best)) best = t;
+      }
+    return best;
+  };
+  Ownership o;
+  o.vertex.assign(static_cast<size_t>(topo.num_vertices), kNoIndex);
+  for (Index v = 0; v < topo.num_vertices; ++v) {
+    const IndexSpan tris = adj.vertex_triangles(v);
+    if (!tris.empty()) o.vertex[static_cast<size_t>(v)] = pick(tris);
+  }
+  o.edge.resize(adj.edges().size());
+  for (size_t e = 0; e < adj.edges().size(); ++e) o.edge[e] = pick(adj.edge_triangles(static_cast<Index>(e)));
+  return o;
+}
+
+/// Per triangle, its pivots: its vertices that every primitive it owns contains (all three if
+/// it owns none), ascending, kNoIndex after the last. Two triangles of one object with a
+/// common pivot c (c is then a vertex of both) have no primitive pair to test: an owned
+/// vertex is c itself, a corner of the other face; two owned edges both end at c. So a self
+/// search from f skips a pair, and a BVH subtree, whose triangles all have a pivot of f as a
+/// pivot (TriangleBvh::node_common_vertices() of the pivots): the triangles of a fan around
+/// one hub all overlap there, and without this each pair of them was a candidate (a cylinder
+/// of 8,000 segments: 64 M triangle pairs per step).
+std::vector<Face> pivots(const Topology& topo, const Ownership& own) {
+  const Adjacency& adj = adjacency(topo);
+  std::vector<Face> out(static_cast<size_t>(topo.num_triangles()));
+  for (Index t = 0; t < topo.num_triangles(); ++t) {
+    const Face& f = topo.faces[static_cast<size_t>(t)];
+    Face p{kNoIndex, kNoIndex, kNoIndex};
+    int n = 0;
+    for (size_t k = 0; k < 3; ++k) {
+      const Index c = f[k];
+      if (repeats_earlier(f, k)) continue;
+      bool all = true;
+      for (size_t m = 0; m < 3 && all; ++m)
+        if (own.vertex[static_cast<size_t>(f[m])] == t && f[m] != c) all = false;
+      for (const Index e : adj.triangle_edges(t)) {
+        if (!all) break;
+        if (e == kNoIndex || own.edge[static_cast<size_t>(e)] != t) continue;
+        const auto& ends = adj.edges()[static_cast<size_t>(e)];
+        if (ends[0] != c && ends[1] != c) all = false;
+      }
+      if (all) p[static_cast<size_t>(n++)] = c;
+    }
+    for (int a = 1; a < n; ++a)  // ascending
+      for (int b = a; b > 0 && p[static_cast<size_t>(b)] < p[static_cast<size_t>(b - 1)]; --b)
+        std::swap(p[static_cast<size_t>(b)], p[static_cast<size_t>(b - 1)]);
+    out[static_cast<size_t>(t)] = p;
+  }
+  return out;
 }
 
 /// A triangle's corners at the start and at the end of the step, with the axes it offers to
@@ -611,12 +669,17 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
 
   std::vector<TriangleBvh> bvhs(from.objects.size());
   std::vector<Ownership> owners(from.objects.size());
+  std::vector<std::vector<Face>> pivot(from.objects.size());
+  std::vector<std::vector<std::array<Index, 3>>> node_pivots(from.objects.size());
   std::vector<std::vector<SweptTriangle>> swept(from.objects.size());
   std::vector<EndBoxes> ends(from.objects.size());
   parallel_for(live.size(), threads, [&](size_t k) {
     const size_t i = static_cast<size_t>(live[k]);
     bvhs[i].build(sweep.triangles[i]);
-    owners[i] = ownership(*from.objects[i].topology);
+    const Topology& topo = *from.objects[i].topology;
+    owners[i] = ownership(topo, true);
+    pivot[i] = pivots(topo, owners[i]);
+    node_pivots[i] = bvhs[i].node_common_vertices(pivot[i]);
     swept[i] = swept_triangles(from.objects[i], to.objects[i]);
     ends[i] = EndBoxes::of(swept[i], bvhs[i]);
   });
@@ -724,7 +787,10 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
       const AABB& f_end = ends_i.end[static_cast<size_t>(f)];
       const double f_share = ends_i.share[static_cast<size_t>(f)];
       const Vec3 f_motion = 0.5 * ((f_end.lo + f_end.hi) - (f_start.lo + f_start.hi));  // its box center's
+      const Face& f_pivots = pivot[static_cast<size_t>(i)][static_cast<size_t>(f)];
       const auto subtree_apart = [&](std::int32_t node) {
+        if (self && TriangleBvh::adjacent_subtree(node_pivots[static_cast<size_t>(j)][static_cast<size_t>(node)], f_pivots))
+          return true;  // no primitive pair to test with any triangle below (pivots())
         const AABB& n_start = ends_j.node_start[static_cast<size_t>(node)];
         const AABB& n_end = ends_j.node_end[static_cast<size_t>(node)];
         const double apart_gap = 2 * (f_share + ends_j.node_share[static_cast<size_t>(node)]);
@@ -739,6 +805,8 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
       };
       bvhs[static_cast<size_t>(j)].query_overlaps(fb, subtree_apart, [&](Index g) {
         if (self && g <= f) return;  // each unordered pair once
+        if (self && TriangleBvh::adjacent_subtree(pivot[static_cast<size_t>(j)][static_cast<size_t>(g)], f_pivots))
+          return;  // a common pivot: no primitive pair to test
         if (voxels && (!self && !voxels->keeps(j, g))) return;
         if (voxels && !voxels->share_voxel(i, f, j, g)) return;
         ++hits.counters.triangle_pairs;
