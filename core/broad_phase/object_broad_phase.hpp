@@ -28,6 +28,11 @@ struct FrameBoxes {
   std::vector<AABB> objects;                 ///< empty box for an object without triangles
   double magnitude = 0;                      ///< largest |coordinate| of any triangle corner
   std::vector<double> magnitudes;            ///< the same per object (0 without triangles)
+  /// Per object, a ball and a hollow around its box's centre c: every point of its triangles
+  /// lies within `outer` of c, and none within `inner` of c (the smallest distance from c to
+  /// a triangle). See enclosure_lower_bound().
+  std::vector<Vec3> centers;
+  std::vector<double> outer, inner;
 
   static FrameBoxes compute(const Frame& frame, int threads);
 
@@ -80,6 +85,14 @@ struct ObjectBroadPhase {
 /// relative to `magnitude` (the largest coordinate magnitude), plus 2^-500 for underflow, so
 /// it scales with the scene.
 double rounding_slack(double magnitude);
+
+/// A lower bound on the distance between objects i and j from their enclosures (FrameBoxes):
+/// when i lies in j's hollow, every point of i is within |c_i - c_j| + outer_i of c_j and every
+/// point of j at least inner_j from it, so d(i, j) >= inner_j - |c_i - c_j| - outer_i (and the
+/// same the other way round). Nested shells, or anything inside a closed surface, have boxes
+/// that contain each other: box distances are 0 between all of them, this is not. Widened
+/// down by the rounding slack of the two objects' coordinates; 0 when it says nothing.
+double enclosure_lower_bound(const FrameBoxes& boxes, Index i, Index j);
 
 /// The paper's rule: along each axis, the object whose interval overlaps i's the most (or the
 /// nearest interval when none overlaps) is a potentially closest object. To those we add the

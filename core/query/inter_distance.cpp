@@ -77,6 +77,7 @@ InterObjectDistance to_result(Index i, const Best& best) {
 struct SearchScratch {
   TriangleBvh::BestFirst search;
   std::vector<std::pair<Index, Index>> probe_pair;  ///< (other object j, own triangle) per probe
+  std::vector<std::pair<double, Index>> order;      ///< (squared lower bound, j) of the PNS
 };
 
 /// Searches object i's PNS for its nearest object, updating `best`. Feature-level culling
@@ -117,12 +118,25 @@ void search_object(const Frame& frame, const FrameBoxes& boxes,
   };
   scratch.search.clear();
   scratch.probe_pair.clear();
+  // Objects in order of a lower bound on their distance: the box distance, or the enclosure
+  // bound when larger (enclosure_lower_bound(): objects inside a closed surface, or nested
+  // shells, whose boxes contain each other). Probes then join after the search has run up to
+  // their object's bound, which may exceed their box distances: the order of the visits
+  // changes, not what is visited within the final bound (each probe stays queued until run()
+  // reaches it), and an object whose bound exceeds the answer is skipped whole.
+  auto& order = scratch.order;
+  order.clear();
   for (Index j : pns) {
+    const double box_d2 = box_distance_squared(boxes.objects[ui], boxes.objects[static_cast<size_t>(j)]);
+    const double lb = enclosure_lower_bound(boxes, i, j);
+    order.emplace_back(std::max(box_d2, lb * lb), j);
+  }
+  std::sort(order.begin(), order.end());
+  for (const auto& [dj2, j] : order) {
     const AABB& box_j = boxes.objects[static_cast<size_t>(j)];
-    const double dj2 = box_distance_squared(boxes.objects[ui], box_j);
     scratch.search.run(bound, keep, visit, dj2);
     const double b = bound();
-    if (dj2 > b * b) break;  // PNS: sorted by box distance
+    if (dj2 > b * b) break;  // sorted by that bound
     if (best.contact_prunes(j)) continue;
     ++counters.object_pns_pairs;
     for (Index t = 0; t < static_cast<Index>(tb_i.size()); ++t) {

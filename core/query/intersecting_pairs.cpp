@@ -43,6 +43,9 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
   const auto object_pairs = overlapping_box_pairs(boxes.object_tree(), boxes.objects, threads);
   std::vector<char> needs_bvh(n, 0);
   for (const auto& [i, j] : object_pairs) {
+    // Boxes that overlap because one object lies inside the other's closed surface (nested
+    // shells): the enclosure bound keeps them apart.
+    if (enclosure_lower_bound(boxes, i, j) > 0) continue;
     add_chunks(i, j);
     needs_bvh[static_cast<size_t>(j)] = 1;
   }

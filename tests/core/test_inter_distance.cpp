@@ -293,6 +293,62 @@ TEST(ObjectBroadPhase, LongParallelSticksKeepLocalBounds) {
   test::expect_same_inter(inter_object_distance(frame, {2}), ref, "sticks");
 }
 
+/// Nested shells around one centre, small blobs inside the outermost, and one shell off centre
+/// that cuts through two others: boxes that contain each other, so every box distance is 0.
+Frame nested_frame(std::uint64_t seed) {
+  Rng rng(seed);
+  Frame frame;
+  const Vec3 c(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+  for (int k = 0; k < 6; ++k)
+    frame.objects.push_back(make_blob(rng, c, 1.0 + 0.35 * k, 2, 0.03, "shell" + std::to_string(k)));
+  for (int k = 0; k < 4; ++k) {
+    const Vec3 at = c + Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)).normalized() * 2.6;
+    frame.objects.push_back(make_blob(rng, at, 0.1, 1, 0.2, "grain" + std::to_string(k)));
+  }
+  frame.objects.push_back(make_blob(rng, c + Vec3(0.5, 0, 0), 1.5, 2, 0.03, "off-centre"));
+  return frame;
+}
+
+// The enclosure bound (object_broad_phase.hpp) never exceeds the true distance between two
+// objects, nested or not; and it separates nested shells whose boxes contain each other.
+TEST(ObjectBroadPhase, EnclosureBoundIsALowerBound) {
+  int nested_positive = 0;
+  for (std::uint64_t seed = 1; seed <= 2; ++seed) {
+    for (const Frame& frame : {nested_frame(seed), make_random_frame(seed, 8, 1.0 + static_cast<double>(seed), 1)}) {
+      const bool nested = frame.objects.size() == 11;
+      const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
+      for (size_t i = 0; i < frame.objects.size(); ++i)
+        for (size_t j = 0; j < frame.objects.size(); ++j) {
+          if (i == j) continue;
+          double dij = kInfinity;
+          for (Index a = 0; a < frame.objects[i].num_triangles(); ++a)
+            for (Index b = 0; b < frame.objects[j].num_triangles(); ++b)
+              dij = std::min(dij, triangle_distance(frame.objects[i].triangle(a), frame.objects[j].triangle(b)).distance);
+          const double lb = enclosure_lower_bound(boxes, static_cast<Index>(i), static_cast<Index>(j));
+          EXPECT_LE(lb, dij) << "seed " << seed << " objects " << i << ", " << j;
+          EXPECT_EQ(lb, enclosure_lower_bound(boxes, static_cast<Index>(j), static_cast<Index>(i)));
+          // The 6 concentric shells (30 ordered pairs per frame).
+          nested_positive += nested && i < 6 && j < 6 && lb > 0;
+        }
+    }
+  }
+  EXPECT_GE(nested_positive, 2 * 24);  // most: coarse blobs have a thin hollow
+}
+
+// Nested shells and objects inside a closed surface: the answers equal brute force, and the
+// search leaves out the objects that the enclosure bound puts beyond the answer (with box
+// distances alone, every object's search went through every other object).
+TEST(InterDistance, NestedShellsEqualBruteForce) {
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    const Frame frame = nested_frame(seed);
+    const auto ref = inter_object_distance_brute_force(frame);
+    const auto got = inter_object_distance(frame, {2});
+    test::expect_same_inter(got, ref, "nested seed " + std::to_string(seed));
+    // 29-31 object pairs searched (of 110); 57-59 with box distances alone.
+    EXPECT_LE(got.counters.object_pns_pairs, 40u) << "seed " << seed;
+  }
+}
+
 TEST(OverlappingBoxPairs, EqualsAllPairs) {
   // Integer boxes in a small range: many touch exactly (closed boxes count), some coincide;
   // every seventh id is left out of the query.

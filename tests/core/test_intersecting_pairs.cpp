@@ -94,6 +94,25 @@ TEST(IntersectingPairs, FanAroundAHubWithCrossingTrianglesEqualsBruteForce) {
   }
 }
 
+// Nested shells around one centre with one off centre cutting through some of them: boxes
+// contain each other, so box overlap pairs every shell with every other; the enclosure bound
+// (object_broad_phase.hpp) leaves only the pairs that can touch, with the same answer.
+TEST(IntersectingPairs, NestedShellsEqualBruteForce) {
+  size_t found = 0;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    Rng rng(seed);
+    Frame frame;
+    for (int k = 0; k < 6; ++k)
+      frame.objects.push_back(test::make_blob(rng, Vec3(0, 0, 0), 1.0 + 0.35 * k, 2, 0.03, "shell" + std::to_string(k)));
+    frame.objects.push_back(test::make_blob(rng, Vec3(0.5, 0.1, 0), 1.5, 2, 0.03, "off-centre"));
+    const auto ref = intersecting_pairs_brute_force(frame, false);
+    const auto got = intersecting_pairs(frame, {2, nullptr, false});
+    EXPECT_EQ(got.pairs, ref.pairs) << "seed " << seed;
+    found += ref.pairs.size();
+  }
+  EXPECT_GT(found, 0u);
+}
+
 TEST(IntersectingPairs, CanonicalOrder) {
   const Frame frame = mixed_frame(4);
   const auto got = intersecting_pairs(frame, {2, nullptr, true});
