@@ -43,6 +43,8 @@ class TriangleBvh {
   }
 
   bool empty() const { return nodes_.empty(); }
+  /// The box of a node (the union of its triangles' boxes), by the index skip() receives.
+  const AABB& node_box(std::int32_t node) const { return nodes_[static_cast<size_t>(node)].box; }
 
   /// The union, per node, of another box per triangle (`boxes[t]`, e.g. the triangles' boxes
   /// at one end of a CCD step), indexed as the nodes are for query_overlaps().
