@@ -2,6 +2,7 @@
 
 #include "core/broad_phase/object_broad_phase.hpp"
 #include "core/broad_phase/triangle_bvh.hpp"
+#include "core/geometry/triangle_box.hpp"
 #include "core/geometry/triangle_distance.hpp"
 #include "core/mesh/adjacency.hpp"
 #include "core/parallel.hpp"
@@ -25,36 +26,6 @@ constexpr Index kChunk = 256;  // triangles per work item: enough items to balan
 /// The sum of a box's sides.
 double box_size(const AABB& b) { return (b.hi - b.lo).sum(); }
 
-/// Whether a box lies strictly on one side of a triangle's plane, so that no triangle inside
-/// it can touch the triangle (a common point would lie on that plane). A long sliver crossing
-/// a fine mesh has a box over a large part of it; this keeps the search to the BVH nodes its
-/// plane cuts (50 slivers across a 180,000-triangle sheet: 3.1 M triangle tests before).
-///
-/// Rounding (u = 2^-53, M the largest |coordinate| of the triangle and the box): the edges
-/// are within 2uM of exact per component and the computed normal n̂ within 40uM^2 of the
-/// exact one; the box's centre and half sides are within uM. So the computed signed distance
-/// of the centre, n̂ . (m - a), and the computed spread Σ|n̂_k| h_k are each within
-/// 240uM^3 + 13u|n̂|_1 M of the exact values; E = 2^-40 (M^3 + |n̂|_1 M) exceeds their sum.
-/// (A degenerate triangle, exact normal 0, then never rejects: its computed values stay
-/// below E.) Coordinates are at least 2^-200 in magnitude when not 0 (types.hpp), so M^3
-/// does not underflow; an overflow makes E or the values infinite or NaN, which never rejects.
-struct PlaneSide {
-  Vec3 a, n;
-  double n1 = 0, m = 0;  ///< |n̂|_1 and the triangle's largest |coordinate|
-
-  explicit PlaneSide(const Triangle& t)
-      : a(t[0]), n((t[1] - t[0]).cross(t[2] - t[0])), n1(n.cwiseAbs().sum()),
-        m(std::max({t[0].cwiseAbs().maxCoeff(), t[1].cwiseAbs().maxCoeff(), t[2].cwiseAbs().maxCoeff()})) {}
-
-  bool rejects(const AABB& box) const {
-    const double mm = std::max({m, box.lo.cwiseAbs().maxCoeff(), box.hi.cwiseAbs().maxCoeff()});
-    const double e = 0x1p-40 * (mm * mm * mm + n1 * mm);
-    const Vec3 centre = 0.5 * (box.lo + box.hi), half = 0.5 * (box.hi - box.lo);
-    const double d = n.dot(centre - a);
-    const double r = n.cwiseAbs().dot(half);
-    return d - r > e || d + r < -e;
-  }
-};
 
 }  // namespace
 
@@ -82,7 +53,7 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
     // shells): the enclosure bound keeps them apart.
     if (enclosure_lower_bound(boxes, i, j) > 0) continue;
     // The object with fewer triangles searches the other's BVH: then its triangles' planes
-    // prune the larger one's nodes (PlaneSide), which is what a sliver across a fine mesh needs.
+    // prune the larger one's nodes (TrianglePlane), which is what a sliver across a fine mesh needs.
     const bool swap = frame.objects[static_cast<size_t>(j)].num_triangles() < frame.objects[static_cast<size_t>(i)].num_triangles();
     const Index from = swap ? j : i, into = swap ? i : j;
     add_chunks(from, into);
@@ -118,7 +89,7 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
         const Face& ff = oi.topology->faces[static_cast<size_t>(f)];
         const auto& node_common = common[static_cast<size_t>(w.i)];
         const TriangleBvh& bvh = boxes.bvh(static_cast<size_t>(w.i));
-        const PlaneSide plane(oi.triangle(f));
+        const TrianglePlane plane(oi.triangle(f));
         const double size_f = box_size(tb_i[static_cast<size_t>(f)]);
         auto skip = [&](std::int32_t node) {
           return TriangleBvh::adjacent_subtree(node_common[static_cast<size_t>(node)], ff) ||
@@ -147,7 +118,7 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
         const AABB& bf = tb_i[static_cast<size_t>(f)];
         if (!boxes_overlap(bf, box_j)) continue;
         const TriangleBvh& bvh = boxes.bvh(static_cast<size_t>(w.j));
-        const PlaneSide plane(oi.triangle(f));
+        const TrianglePlane plane(oi.triangle(f));
         bvh.query_overlaps(bf, [&](std::int32_t node) { return plane.rejects(bvh.node_box(node)); }, [&](Index g) {
           if (low_j && low_j[g] > 0.0) return;
           ++tests[k];

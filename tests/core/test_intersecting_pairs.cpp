@@ -1,6 +1,8 @@
 // Discrete collisions: the list of intersecting triangle pairs equals the all-pairs brute
 // force (exact triangle–triangle intersection) with and without Stage II bounds, for any
 // thread count.
+#include "core/geometry/predicates.hpp"
+#include "core/geometry/triangle_box.hpp"
 #include "core/mesh/adjacency.hpp"
 #include "core/query/intersecting_pairs.hpp"
 #include "core/voronoi/stage2.hpp"
@@ -94,6 +96,46 @@ TEST(IntersectingPairs, FanAroundAHubWithCrossingTrianglesEqualsBruteForce) {
     const auto got = intersecting_pairs(frame, {threads, nullptr, true});
     EXPECT_EQ(got.pairs, ref.pairs);
   }
+}
+
+// The plane test of the search (triangle_box.hpp) against exact orientation predicates: a box
+// it rejects has all 8 corners strictly on the same side of the triangle's plane. Random
+// triangles (some nearly degenerate) at scales 1e-8 to 1e8, far from the origin or not, and
+// boxes placed across, beside and just off the plane.
+TEST(TrianglePlane, RejectsOnlyBoxesStrictlyOnOneSide) {
+  Rng rng(4711);
+  int rejected = 0, close = 0;
+  for (int q = 0; q < 200000; ++q) {
+    const double scale = std::pow(10.0, rng.uniform(-8, 8));
+    const double offset = q % 3 == 0 ? 0.0 : std::pow(10.0, rng.uniform(-8, 12)) * (q % 2 ? 1 : -1);
+    auto point = [&]() -> Vec3 { return Vec3::Constant(offset) + scale * Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)); };
+    Triangle t{point(), point(), point()};
+    if (q % 7 == 0) t[2] = t[0] + (t[1] - t[0]) * rng.uniform(-1, 2) + scale * 1e-12 * Vec3(rng.uniform(-1, 1), 0, 0);
+    // A box centred near the plane, at a distance from 0 to 10 box sizes off it.
+    const Vec3 nrm = (t[1] - t[0]).cross(t[2] - t[0]);
+    const double len = nrm.norm();
+    Vec3 dir(1, 0, 0);
+    if (len > 0) dir = nrm / len;
+    const double size = scale * std::pow(10.0, rng.uniform(-6, 0));
+    const double off = size * std::pow(10.0, rng.uniform(-9, 1)) * (q % 4 < 2 ? 1 : -1);
+    const Vec3 c = t[0] + (t[1] - t[0]) * rng.uniform(0, 1) + dir * off;
+    AABB box;
+    box.extend(c - size * Vec3(rng.uniform(0, 1), rng.uniform(0, 1), rng.uniform(0, 1)));
+    box.extend(c + size * Vec3(rng.uniform(0, 1), rng.uniform(0, 1), rng.uniform(0, 1)));
+    if (!TrianglePlane(t).rejects(box)) continue;
+    ++rejected;
+    close += std::abs(off) < 2 * size;
+    int sign = 0;
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 corner((k & 1) ? box.hi.x() : box.lo.x(), (k & 2) ? box.hi.y() : box.lo.y(), (k & 4) ? box.hi.z() : box.lo.z());
+      const int o = orient3d(t[0], t[1], t[2], corner);
+      ASSERT_NE(o, 0) << "query " << q;
+      if (k == 0) sign = o;
+      ASSERT_EQ(o, sign) << "query " << q;
+    }
+  }
+  EXPECT_GT(rejected, 10000);
+  EXPECT_GT(close, 5000);
 }
 
 // Long slivers across a fine wavy sheet, as separate objects and inside the sheet's own object:
