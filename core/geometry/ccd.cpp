@@ -251,7 +251,7 @@ inline bool excludes_moving(const double wa[3], const double wb[3], const double
 
 /// The moving-direction test with the three directions proposed by the box's two t faces;
 /// `ends_apart` as in excludes_moving() for any of them.
-bool excluded_along_moving_directions(const double F[8][3], const double eps[3], const double fmax[3],
+[[gnu::noinline]] bool excluded_along_moving_directions(const double F[8][3], const double eps[3], const double fmax[3],
                                       bool& ends_apart) {
   double wa[3][3], wb[3][3];
   face_directions(F, 0, wa);
@@ -266,8 +266,11 @@ bool excluded_along_moving_directions(const double F[8][3], const double eps[3],
   return false;
 }
 
-/// Boxes a query evaluates before it also tries the moving directions.
-constexpr std::uint32_t kMovingAfter = 64;
+/// Boxes a query evaluates before it also tries the moving directions; the tries after which
+/// they must have excluded at least 1 box in kMovingYield to go on being tried.
+constexpr std::uint32_t kMovingAfter = 128;
+constexpr std::uint32_t kMovingTrial = 64;
+constexpr std::uint32_t kMovingYield = 16;
 
 CcdResult conservative_hit(double t, std::uint32_t boxes) {
   CcdResult r;
@@ -315,6 +318,7 @@ CcdResult solve(Kind kind, const std::array<Vec3, 4>& start, const std::array<Ve
   stack.push_back({0, 1, 0, 1, 0, 1});
   CcdResult result;
   double best = kInfinity;
+  std::uint32_t moving_tries = 0, moving_hits = 0;
   double x[4][3];
   double F[8][3];
   while (!stack.empty()) {
@@ -350,20 +354,30 @@ CcdResult solve(Kind kind, const std::array<Vec3, 4>& start, const std::array<Ve
     if (excluded) continue;
     if (excluded_along_box_directions(F, q.eps, fmax)) continue;
     // The moving directions cost about as much again as the rest of a box; queries decided
-    // within kMovingAfter boxes (nearly all) do without them.
+    // within kMovingAfter boxes (nearly all) do without them, and so does a query on which
+    // they have excluded fewer than 1 box in kMovingYield after kMovingTrial tries.
     bool ends_apart = false;
-    if (result.boxes > kMovingAfter && excluded_along_moving_directions(F, q.eps, fmax, ends_apart)) continue;
+    if (result.boxes > kMovingAfter && (moving_tries < kMovingTrial || moving_hits * kMovingYield >= moving_tries)) {
+      ++moving_tries;
+      if (excluded_along_moving_directions(F, q.eps, fmax, ends_apart)) {
+        ++moving_hits;
+        continue;
+      }
+    }
     if (inside) {
       best = b.t0;  // b.t0 < best, checked above
       continue;
     }
 
-    // Which side to split: t when the box reaches past `best`; otherwise the side along which
-    // F varies most relative to δ (it shrinks the corner range fastest). Corner c and
-    // c | bit differ only in parameter `dim` (bit = 1 << dim).
+    // Which side to split: t when the box reaches past `best`, or for edge–edge when the
+    // moving directions separated both ends of the box but not its middle (the turning is what
+    // keeps it: halving t quarters that term; for vertex–face this made some queries 4x
+    // slower and none much faster); otherwise the side along which F varies most relative to
+    // δ (it shrinks the corner range fastest). Corner c and c | bit differ only in parameter
+    // `dim` (bit = 1 << dim).
     const double width[3] = {b.t1 - b.t0, b.u1 - b.u0, b.v1 - b.v0};
     int split = -1;
-    if ((b.t1 > best || ends_apart) && width[0] > kMinWidth) {
+    if ((b.t1 > best || (ends_apart && kind == Kind::EdgeEdge)) && width[0] > kMinWidth) {
       split = 0;
     } else {
       double best_var = -1;

@@ -751,7 +751,9 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
     // Separation that rules out a report: the kernel reports a pair whose primitives come
     // within δ_k on every axis (at most sqrt(3) δmax apart), and margin >= δmax + slack. The
     // margin is the sum of the shares of the two triangles at hand, or of a triangle and a
-    // BVH subtree (EndBoxes).
+    // BVH subtree (EndBoxes), or the object pair's margin when smaller (both are valid; far
+    // from the origin the rounding slack dominates, and each share carries its own).
+    const double object_margin = sweep.pair_margin(i, j);
 
     // Vertex v of object ov (owned by tri fv) against face g of object og.
     auto vertex_face = [&](Index ov, const std::vector<AABB>& v_boxes, Index v, Index og, const Face& g_face, Index g,
@@ -793,7 +795,7 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
           return true;  // no primitive pair to test with any triangle below (pivots())
         const AABB& n_start = ends_j.node_start[static_cast<size_t>(node)];
         const AABB& n_end = ends_j.node_end[static_cast<size_t>(node)];
-        const double apart_gap = 2 * (f_share + ends_j.node_share[static_cast<size_t>(node)]);
+        const double apart_gap = 2 * std::min(object_margin, f_share + ends_j.node_share[static_cast<size_t>(node)]);
         if (apart_at_both_ends(f_start, f_end, n_start, n_end, apart_gap)) return true;
         // A triangle moving fast relative to the subtree (by more than twice its own size):
         // the axes perpendicular to that motion, as in swept_apart().
@@ -811,7 +813,7 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
         if (voxels && !voxels->share_voxel(i, f, j, g)) return;
         ++hits.counters.triangle_pairs;
         const Face& gf = oj.topology->faces[static_cast<size_t>(g)];
-        const double margin = f_share + ends_j.share[static_cast<size_t>(g)];
+        const double margin = std::min(object_margin, f_share + ends_j.share[static_cast<size_t>(g)]);
         const double apart_gap = 2 * margin;
         if (apart_at_both_ends(f_start, f_end, ends_j.start[static_cast<size_t>(g)], ends_j.end[static_cast<size_t>(g)],
                                apart_gap) ||
