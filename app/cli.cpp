@@ -212,8 +212,9 @@ int cli_main(int argc, char** argv) {
   app.add_option("--grid", config.grid,
                  "Voronoi grid: cells along the longest axis of the scene box (default: the "
                  "scene's \"grid\", else per query: 4*cbrt(triangles) clamped to [32, 256] for "
-                 "the inter-object distance, sqrt(triangles) clamped to [32, 512] for the "
-                 "intra-object distance, for CCD a cell from the triangles' sizes)")
+                 "the inter-object distance, sqrt(triangles) clamped to [32, 512] but cells no "
+                 "smaller than 0.7 median triangle for the intra-object distance, for CCD a "
+                 "cell from the triangles' sizes)")
       ->check(whole_number(1, kMaxGridResolution, "cells along the longest axis"));
   app.add_option("--device", config.device, "EGL device index for --voronoi=gpu (default: first hardware device)")
       ->check(whole_number(0, 1023, "an EGL device index"));

@@ -48,17 +48,26 @@ bool may_have_candidate(const Adjacency& adj, const Face& f, Index n) {
   return static_cast<Index>(std::unique(seen, seen + k) - seen) < n;
 }
 
+/// The default self grid's cell is at least this times the median triangle's box size.
+constexpr double kSelfCellOverMedianSize = 0.7;
+
 }  // namespace
 
-int default_self_grid_resolution(std::int64_t triangles) {
+int default_self_grid_resolution(std::int64_t triangles, double longest, double median_size) {
   // The self bounds cull only when δ (~0.9 cell) is below the distances between neighbouring
   // non-adjacent triangles, about half an edge length; for a surface of n triangles spanning
   // the grid an edge is ~ extent / sqrt(n / 2), so the cell must shrink like 1 / sqrt(n).
   // sqrt(n) cells along the longest axis (cell ~ 0.7 edge), clamped to [32, 512], keeps Stage
   // II's cost moderate; on the cloth-funnel frame finer grids cull a little more but cost more
-  // than they save (README, "Intra-object distance").
+  // than they save (README, "Intra-object distance"). Objects that do not span the grid (a
+  // crowd of small ones) have edges far above extent / sqrt(n): there the cell is not made
+  // smaller than 0.7 times the median triangle's box (its longest side), which sqrt(n) cells
+  // about match for one surface spanning the grid. 2,000 blobs of 180 triangles: 27.7 samples
+  // per triangle at 512 cells, self Stage II 7.7 s, and no exact test culled.
   const double g = std::sqrt(static_cast<double>(std::max<std::int64_t>(triangles, 1)));
-  return static_cast<int>(std::clamp(std::lround(g), 32L, 512L));
+  double res = g;
+  if (longest > 0 && median_size > 0) res = std::min(res, longest / (kSelfCellOverMedianSize * median_size));
+  return static_cast<int>(std::clamp(std::lround(res), 32L, 512L));
 }
 
 void validate_self_dvd_input(const SelfDvdInput& in) {
@@ -93,7 +102,18 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
   }
   if (scene.empty()) return out;
 
-  const int res = grid_resolution > 0 ? grid_resolution : default_self_grid_resolution(total_tris);
+  int res = grid_resolution;
+  if (res <= 0) {
+    std::vector<double> size;
+    size.reserve(static_cast<size_t>(total_tris));
+    for (size_t i = 0; i < n; ++i) {
+      if (frame.objects[i].num_triangles() < 2) continue;
+      for (const AABB& b : boxes.triangles[i]) size.push_back((b.hi - b.lo).maxCoeff());
+    }
+    auto mid = size.begin() + static_cast<std::ptrdiff_t>(size.size() / 2);
+    std::nth_element(size.begin(), mid, size.end());
+    res = default_self_grid_resolution(total_tris, (scene.hi - scene.lo).maxCoeff(), *mid);
+  }
   const StageGrid sg = StageGrid::over(scene, res);
   out.grid = sg.grid;
   out.delta_precision = sg.delta_precision(backend);

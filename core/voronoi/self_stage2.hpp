@@ -74,8 +74,11 @@ struct SelfVoronoiBounds {
   double setup_ms = 0, upload_ms = 0, compute_ms = 0, readback_ms = 0, scan_ms = 0;
 };
 
-/// Grid resolution for the self query when none is given (see self_stage2.cpp).
-int default_self_grid_resolution(std::int64_t triangles);
+/// Grid resolution for the self query when none is given (see self_stage2.cpp): sqrt(n)
+/// cells along the longest axis (`longest`, of the sampled objects' box), but cells no
+/// smaller than 0.7 times `median_size` (the median triangle box's longest side), clamped to
+/// [32, 512].
+int default_self_grid_resolution(std::int64_t triangles, double longest, double median_size);
 
 /// Runs the self Stage II on a frame. `ring2_bound` is ring2_upper_bounds(frame) (query/
 /// intra_distance.hpp): it sets each triangle's band, and a triangle whose 2-ring bound is at
