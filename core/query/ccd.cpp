@@ -228,8 +228,6 @@ bool primitives_apart(const SweptPrimitives<NA, NB>& p, std::initializer_list<Ve
   return false;
 }
 
-/// Per object: each triangle's box at the start and at the end of the step, and their unions
-/// over each node of the object's swept-box BVH.
 /// The largest |coordinate| of a box.
 double box_magnitude(const AABB& b) { return std::max(b.lo.cwiseAbs().maxCoeff(), b.hi.cwiseAbs().maxCoeff()); }
 
