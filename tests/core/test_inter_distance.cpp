@@ -19,6 +19,15 @@ using test::make_random_frame;
 using test::make_soup;
 using test::Rng;
 
+/// The distance between objects i and j of a frame, over all their triangle pairs.
+double object_distance(const Frame& frame, size_t i, size_t j) {
+  double d = kInfinity;
+  for (Index a = 0; a < frame.objects[i].num_triangles(); ++a)
+    for (Index b = 0; b < frame.objects[j].num_triangles(); ++b)
+      d = std::min(d, triangle_distance(frame.objects[i].triangle(a), frame.objects[j].triangle(b)).distance);
+  return d;
+}
+
 TEST(InterDistance, RandomBlobScenesEqualBruteForce) {
   std::uint64_t separated = 0;
   for (std::uint64_t seed = 1; seed <= 12; ++seed) {
@@ -212,10 +221,7 @@ TEST(ObjectBroadPhase, BoundsAndPnsAreConservative) {
       // ...and every object within U_i (in particular the nearest) is in PNS(i).
       for (size_t j = 0; j < frame.objects.size(); ++j) {
         if (j == i) continue;
-        double dij = kInfinity;
-        for (Index a = 0; a < frame.objects[i].num_triangles(); ++a)
-          for (Index b = 0; b < frame.objects[j].num_triangles(); ++b)
-            dij = std::min(dij, triangle_distance(frame.objects[i].triangle(a), frame.objects[j].triangle(b)).distance);
+        const double dij = object_distance(frame, i, j);
         if (dij <= bp.upper_bound[i]) {
           const auto& p = bp.pns[i];
           EXPECT_NE(std::find(p.begin(), p.end(), static_cast<Index>(j)), p.end())
@@ -320,10 +326,7 @@ TEST(ObjectBroadPhase, EnclosureBoundIsALowerBound) {
       for (size_t i = 0; i < frame.objects.size(); ++i)
         for (size_t j = 0; j < frame.objects.size(); ++j) {
           if (i == j) continue;
-          double dij = kInfinity;
-          for (Index a = 0; a < frame.objects[i].num_triangles(); ++a)
-            for (Index b = 0; b < frame.objects[j].num_triangles(); ++b)
-              dij = std::min(dij, triangle_distance(frame.objects[i].triangle(a), frame.objects[j].triangle(b)).distance);
+          const double dij = object_distance(frame, i, j);
           const double lb = enclosure_lower_bound(boxes, static_cast<Index>(i), static_cast<Index>(j));
           EXPECT_LE(lb, dij) << "seed " << seed << " objects " << i << ", " << j;
           EXPECT_EQ(lb, enclosure_lower_bound(boxes, static_cast<Index>(j), static_cast<Index>(i)));
