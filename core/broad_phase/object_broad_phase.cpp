@@ -79,9 +79,6 @@ FrameBoxes FrameBoxes::compute(const Frame& frame, int threads) {
   fb.triangles.resize(n);
   fb.objects.assign(n, AABB{});
   std::vector<double> mags(n, 0.0);
-  fb.centers.assign(n, Vec3::Zero());
-  fb.outer.assign(n, 0.0);
-  fb.inner.assign(n, 0.0);
   parallel_for(n, threads, [&](size_t i) {
     const Object& o = frame.objects[i];
     auto& tb = fb.triangles[i];
@@ -92,9 +89,21 @@ FrameBoxes FrameBoxes::compute(const Frame& frame, int threads) {
       box.extend(tb[static_cast<size_t>(t)]);
     }
     fb.objects[i] = box;
-    if (box.empty()) return;
-    mags[i] = std::max(box.lo.cwiseAbs().maxCoeff(), box.hi.cwiseAbs().maxCoeff());
-    const Vec3 c = box.center();
+    if (!box.empty()) mags[i] = std::max(box.lo.cwiseAbs().maxCoeff(), box.hi.cwiseAbs().maxCoeff());
+  });
+  for (double m : mags) fb.magnitude = std::max(fb.magnitude, m);
+  fb.magnitudes = std::move(mags);
+  fb.bvh_cache = std::make_shared<BvhCache>(n);
+  return fb;
+}
+
+namespace {
+
+const Enclosure& enclosure(const Frame& frame, const FrameBoxes& boxes, size_t i) {
+  FrameBoxes::BvhCache& cache = *boxes.bvh_cache;
+  std::call_once(cache.enclosure_once[i], [&] {
+    const Object& o = frame.objects[i];
+    const Vec3 c = boxes.objects[i].center();
     double outer2 = 0, inner2 = kInfinity;
     for (Index t = 0; t < o.num_triangles(); ++t) {
       const Triangle tri = o.triangle(t);
@@ -103,23 +112,22 @@ FrameBoxes FrameBoxes::compute(const Frame& frame, int threads) {
       // at most a few ulps of the magnitude above the exact distance (rounding_slack() covers it).
       inner2 = std::min(inner2, point_triangle_distance(c, tri).squared_distance);
     }
-    fb.centers[i] = c;
-    fb.outer[i] = std::sqrt(outer2);
-    fb.inner[i] = std::sqrt(inner2);
+    cache.enclosures[i] = {c, std::sqrt(outer2), std::sqrt(inner2)};
   });
-  for (double m : mags) fb.magnitude = std::max(fb.magnitude, m);
-  fb.magnitudes = std::move(mags);
-  fb.bvh_cache = std::make_shared<BvhCache>(n);
-  return fb;
+  return cache.enclosures[i];
 }
 
-double enclosure_lower_bound(const FrameBoxes& boxes, Index i, Index j) {
+}  // namespace
+
+double enclosure_lower_bound(const Frame& frame, const FrameBoxes& boxes, Index i, Index j) {
   const auto a = static_cast<size_t>(i), b = static_cast<size_t>(j);
   if (boxes.objects[a].empty() || boxes.objects[b].empty()) return 0;
+  const Enclosure& ea = enclosure(frame, boxes, a);
+  const Enclosure& eb = enclosure(frame, boxes, b);
   // Each term is within a few ulps of its exact value (at most ~4 times the coordinates'
   // magnitude), far inside the rounding slack of their magnitude.
-  const double apart = (boxes.centers[a] - boxes.centers[b]).norm();
-  const double lb = std::max(boxes.inner[b] - apart - boxes.outer[a], boxes.inner[a] - apart - boxes.outer[b]);
+  const double apart = (ea.center - eb.center).norm();
+  const double lb = std::max(eb.inner - apart - ea.outer, ea.inner - apart - eb.outer);
   return std::max(0.0, lb - rounding_slack(std::max(boxes.magnitudes[a], boxes.magnitudes[b])));
 }
 

@@ -28,11 +28,6 @@ struct FrameBoxes {
   std::vector<AABB> objects;                 ///< empty box for an object without triangles
   double magnitude = 0;                      ///< largest |coordinate| of any triangle corner
   std::vector<double> magnitudes;            ///< the same per object (0 without triangles)
-  /// Per object, a ball and a hollow around its box's centre c: every point of its triangles
-  /// lies within `outer` of c, and none within `inner` of c (the smallest distance from c to
-  /// a triangle). See enclosure_lower_bound().
-  std::vector<Vec3> centers;
-  std::vector<double> outer, inner;
 
   static FrameBoxes compute(const Frame& frame, int threads);
 
@@ -49,12 +44,23 @@ struct FrameBoxes {
   std::shared_ptr<BvhCache> bvh_cache;  ///< set by compute()
 };
 
+/// Per object, a ball and a hollow around its box's centre c: every point of its triangles
+/// lies within `outer` of c, and none within `inner` of c (the smallest distance from c to a
+/// triangle). See enclosure_lower_bound().
+struct Enclosure {
+  Vec3 center = Vec3::Zero();
+  double outer = 0, inner = 0;
+};
+
 struct FrameBoxes::BvhCache {
-  explicit BvhCache(std::size_t n) : once(n), bvhs(n) {}
+  explicit BvhCache(std::size_t n) : once(n), bvhs(n), enclosure_once(n), enclosures(n) {}
   std::vector<std::once_flag> once;
   std::vector<TriangleBvh> bvhs;
   std::once_flag object_once;
   ObjectBoxTree object_tree;
+  /// Computed on first use (enclosure_lower_bound()): only pairs whose boxes overlap need them.
+  std::vector<std::once_flag> enclosure_once;
+  std::vector<Enclosure> enclosures;
 };
 
 inline const TriangleBvh& FrameBoxes::bvh(std::size_t i) const {
@@ -86,13 +92,16 @@ struct ObjectBroadPhase {
 /// it scales with the scene.
 double rounding_slack(double magnitude);
 
-/// A lower bound on the distance between objects i and j from their enclosures (FrameBoxes):
-/// when i lies in j's hollow, every point of i is within |c_i - c_j| + outer_i of c_j and every
-/// point of j at least inner_j from it, so d(i, j) >= inner_j - |c_i - c_j| - outer_i (and the
-/// same the other way round). Nested shells, or anything inside a closed surface, have boxes
-/// that contain each other: box distances are 0 between all of them, this is not. Widened
-/// down by the rounding slack of the two objects' coordinates; 0 when it says nothing.
-double enclosure_lower_bound(const FrameBoxes& boxes, Index i, Index j);
+/// A lower bound on the distance between objects i and j from their enclosures (Enclosure,
+/// computed once per object and frame on first use): when i lies in j's hollow, every point of
+/// i is within |c_i - c_j| + outer_i of c_j and every point of j at least inner_j from it, so
+/// d(i, j) >= inner_j - |c_i - c_j| - outer_i (and the same the other way round). Nested
+/// shells, or anything inside a closed surface, have boxes that contain each other: box
+/// distances are 0 between all of them, this is not. Widened down by the rounding slack of
+/// the two objects' coordinates; 0 when it says nothing. Callers use it for pairs whose boxes
+/// overlap (elsewhere the box distance is the better bound, and the enclosures cost one
+/// point-triangle distance per triangle).
+double enclosure_lower_bound(const Frame& frame, const FrameBoxes& boxes, Index i, Index j);
 
 /// The paper's rule: along each axis, the object whose interval overlaps i's the most (or the
 /// nearest interval when none overlaps) is a potentially closest object. To those we add the

@@ -118,9 +118,9 @@ void search_object(const Frame& frame, const FrameBoxes& boxes,
   };
   scratch.search.clear();
   scratch.probe_pair.clear();
-  // Objects in order of a lower bound on their distance: the box distance, or the enclosure
-  // bound when larger (enclosure_lower_bound(): objects inside a closed surface, or nested
-  // shells, whose boxes contain each other). Probes then join after the search has run up to
+  // Objects in order of a lower bound on their distance: the box distance, or for boxes that
+  // overlap the enclosure bound (enclosure_lower_bound(): objects inside a closed surface, or
+  // nested shells, whose boxes contain each other). Probes then join after the search has run up to
   // their object's bound, which may exceed their box distances: the order of the visits
   // changes, not what is visited within the final bound (each probe stays queued until run()
   // reaches it), and an object whose bound exceeds the answer is skipped whole.
@@ -128,7 +128,7 @@ void search_object(const Frame& frame, const FrameBoxes& boxes,
   order.clear();
   for (Index j : pns) {
     const double box_d2 = box_distance_squared(boxes.objects[ui], boxes.objects[static_cast<size_t>(j)]);
-    const double lb = enclosure_lower_bound(boxes, i, j);
+    const double lb = box_d2 > 0 ? 0.0 : enclosure_lower_bound(frame, boxes, i, j);
     order.emplace_back(std::max(box_d2, lb * lb), j);
   }
   std::sort(order.begin(), order.end());

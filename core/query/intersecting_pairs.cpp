@@ -51,7 +51,7 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
   for (const auto& [i, j] : object_pairs) {
     // Boxes that overlap because one object lies inside the other's closed surface (nested
     // shells): the enclosure bound keeps them apart.
-    if (enclosure_lower_bound(boxes, i, j) > 0) continue;
+    if (enclosure_lower_bound(frame, boxes, i, j) > 0) continue;
     // The object with fewer triangles searches the other's BVH: then its triangles' planes
     // prune the larger one's nodes (TrianglePlane), which is what a sliver across a fine mesh needs.
     const bool swap = frame.objects[static_cast<size_t>(j)].num_triangles() < frame.objects[static_cast<size_t>(i)].num_triangles();

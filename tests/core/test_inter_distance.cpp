@@ -327,9 +327,9 @@ TEST(ObjectBroadPhase, EnclosureBoundIsALowerBound) {
         for (size_t j = 0; j < frame.objects.size(); ++j) {
           if (i == j) continue;
           const double dij = object_distance(frame, i, j);
-          const double lb = enclosure_lower_bound(boxes, static_cast<Index>(i), static_cast<Index>(j));
+          const double lb = enclosure_lower_bound(frame, boxes, static_cast<Index>(i), static_cast<Index>(j));
           EXPECT_LE(lb, dij) << "seed " << seed << " objects " << i << ", " << j;
-          EXPECT_EQ(lb, enclosure_lower_bound(boxes, static_cast<Index>(j), static_cast<Index>(i)));
+          EXPECT_EQ(lb, enclosure_lower_bound(frame, boxes, static_cast<Index>(j), static_cast<Index>(i)));
           // The 6 concentric shells (30 ordered pairs per frame).
           nested_positive += nested && i < 6 && j < 6 && lb > 0;
         }
