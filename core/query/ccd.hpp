@@ -22,14 +22,16 @@
 // of one object sharing a vertex. Vertices used by no face take no part.
 //
 // Culling margin: the kernel may report a pair whose primitives come within its tolerance δ
-// (never more than ccd_max_tolerance() for the coordinates of the query's 8 points); each pair
-// of triangles gets that, for the box of their 12 positions, plus rounding_slack() as its
-// margin (ccd_margin_between() of their swept boxes; the primitive box tests widen by it, the
-// separating-axis tests ask for twice that, as the kernel's per-axis δ allows a Euclidean gap
-// of sqrt(3) δ; a triangle against a BVH subtree uses the subtree's box). Triangle boxes are
-// widened by their own share of it (ccd_tolerance_share()), and Stage II by the step's largest
-// margin, so culling never removes a pair the kernel would report and the results equal the
-// brute force — with one documented exception: a
+// (never more than ccd_max_tolerance() for the coordinates of the query's 8 points, which lie
+// among the 12 positions of the two triangles the pair comes from). Each triangle has a share
+// of the margin from its own swept box (ccd_tolerance_share() plus rounding slack), and a
+// triangle pair's margin is the sum of the two shares, or the object pair's margin
+// (ccd_margin_between() of the objects' swept boxes) when smaller; a triangle against a BVH
+// subtree uses the subtree's box's share. The primitive box tests widen by the margin, the
+// separating-axis tests ask for twice that (the kernel's per-axis δ allows a Euclidean gap of
+// sqrt(3) δ). Triangle boxes are widened by their own share, and Stage II by the step's
+// largest margin, so culling never removes a pair the kernel would report and the results
+// equal the brute force — with one documented exception: a
 // test that stops at the kernel's box limit (counters.limit_hits) is reported without a
 // proximity guarantee, so brute force could report such a pair where culling (correctly: it
 // cannot collide) removed it.
