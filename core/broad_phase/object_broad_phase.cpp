@@ -104,10 +104,15 @@ const Enclosure& enclosure(const Frame& frame, const FrameBoxes& boxes, size_t i
   std::call_once(cache.enclosure_once[i], [&] {
     const Object& o = frame.objects[i];
     const Vec3 c = boxes.objects[i].center();
+    AABB point;
+    point.extend(c);
     double outer2 = 0, inner2 = kInfinity;
     for (Index t = 0; t < o.num_triangles(); ++t) {
       const Triangle tri = o.triangle(t);
       for (const Vec3& v : tri) outer2 = std::max(outer2, (v - c).squaredNorm());
+      // A triangle whose box is no nearer than the nearest triangle so far cannot lower it
+      // (the box distance is exact up to one rounding, below the triangle's distance).
+      if (box_distance_squared(point, boxes.triangles[i][static_cast<size_t>(t)]) > inner2) continue;
       // The computed closest point lies on the triangle up to coordinate rounding, so this is
       // at most a few ulps of the magnitude above the exact distance (rounding_slack() covers it).
       inner2 = std::min(inner2, point_triangle_distance(c, tri).squared_distance);
