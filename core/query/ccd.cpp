@@ -239,7 +239,8 @@ double margin_share(const AABB& raw) {
 }
 
 /// Per triangle and per BVH node: the boxes of its points at the start and at the end of the
-/// step, and its share of the culling margin (margin_share() of both boxes together). A pair
+/// step, and its share of the culling margin (margin_share() of both boxes together: the
+/// triangles' from CcdSweep::shares). A pair
 /// of a triangle and a triangle or subtree uses the sum of their shares as its margin: if the
 /// kernel can report one of its queries, their swept boxes come within that query's margin on
 /// every axis, and there the shares add up to at least the margin (ccd_tolerance_share()).
@@ -247,20 +248,16 @@ struct EndBoxes {
   std::vector<AABB> start, end, node_start, node_end;
   std::vector<double> share, node_share;
 
-  static EndBoxes of(const std::vector<SweptTriangle>& tris, const TriangleBvh& bvh) {
+  static EndBoxes of(const std::vector<SweptTriangle>& tris, const TriangleBvh& bvh, const std::vector<double>& shares) {
     EndBoxes e;
     e.start.resize(tris.size());
     e.end.resize(tris.size());
-    e.share.resize(tris.size());
-    for (size_t t = 0; t < tris.size(); ++t) {
+    e.share = shares;
+    for (size_t t = 0; t < tris.size(); ++t)
       for (size_t k = 0; k < 3; ++k) {
         e.start[t].extend(tris[t].start[k]);
         e.end[t].extend(tris[t].end[k]);
       }
-      AABB both = e.start[t];
-      both.extend(e.end[t]);
-      e.share[t] = margin_share(both);
-    }
     e.node_start = bvh.node_unions(e.start);
     e.node_end = bvh.node_unions(e.end);
     e.node_share.resize(e.node_start.size());
@@ -580,7 +577,7 @@ CcdSweep CcdSweep::compute(const Frame& from, const Frame& to, int threads) {
   s.margin = ccd_max_tolerance(extent, magnitude) + rounding_slack(magnitude);
   s.raw_objects.assign(n, AABB{});
   s.magnitudes.assign(n, 0.0);
-  s.widening.assign(n, 0.0);
+  s.shares.assign(n, {});
   const auto& ids = s.participants.objects;
   parallel_for(ids.size(), threads, [&](size_t k) {
     const size_t i = static_cast<size_t>(ids[k]);
@@ -604,22 +601,22 @@ CcdSweep CcdSweep::compute(const Frame& from, const Frame& to, int threads) {
     // object-wide share (1e-6 of the object's size) took in every triangle of a layer stacked
     // closer than that: a 32-layer accordion 1e-6 of an edge apart ran 44M elementary tests.
     auto& tb = s.triangles[i];
+    auto& share = s.shares[i];
     tb.resize(static_cast<size_t>(a.num_triangles()));
+    share.resize(tb.size());
     AABB box;
-    double widest = 0;
     for (Index t = 0; t < a.num_triangles(); ++t) {
       const Face& f = a.topology->faces[static_cast<size_t>(t)];
       AABB tri = vb[static_cast<size_t>(f[0])];
       tri.extend(vb[static_cast<size_t>(f[1])]);
       tri.extend(vb[static_cast<size_t>(f[2])]);
       const double w = margin_share(tri);
-      widest = std::max(widest, w);
+      share[static_cast<size_t>(t)] = w;
       tri.lo.array() -= w;
       tri.hi.array() += w;
       tb[static_cast<size_t>(t)] = tri;
       box.extend(tri);
     }
-    s.widening[i] = widest;
     s.objects[i] = box;
   });
   return s;
@@ -679,7 +676,7 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
     pivot[i] = pivots(topo, owners[i]);
     node_pivots[i] = bvhs[i].node_common_vertices(pivot[i]);
     swept[i] = swept_triangles(from.objects[i], to.objects[i]);
-    ends[i] = EndBoxes::of(swept[i], bvhs[i]);
+    ends[i] = EndBoxes::of(swept[i], bvhs[i], sweep.shares[i]);
   });
   out.aabb_ms = sw.elapsed_ms();
   sw.restart();

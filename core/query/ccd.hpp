@@ -77,19 +77,19 @@ struct CcdSweep {
   /// Culling margin of the whole step (see above): at least the margin of any pair of its
   /// objects (pair_margin()). Stage II widens its prisms by it.
   double margin = 0;
-  /// Per object: its swept box (both frames, all vertices; not widened), the largest
-  /// coordinate magnitude in it, and the most any of its triangle boxes is widened (each by
-  /// its own ccd_tolerance_share(), so that two triangles' widenings add up to at least their
-  /// ccd_margin_between() wherever their boxes come that close).
+  /// Per object: its swept box (both frames, all vertices; not widened) and the largest
+  /// coordinate magnitude in it.
   std::vector<AABB> raw_objects;
   std::vector<double> magnitudes;
-  std::vector<double> widening;
   /// The culling margin of a pair of objects: ccd_margin_between() of their swept boxes (it
   /// bounds the margins of all their triangle pairs). One far-away object does not widen the
   /// margins of the others.
   double pair_margin(Index i, Index j) const;
-  /// [object][triangle] swept boxes (widened by the object's `widening`), empty for skipped
-  /// objects.
+  /// [object][triangle] each triangle's share of the culling margin (ccd_tolerance_share() of
+  /// its swept box plus rounding slack, so that two triangles' shares add up to at least their
+  /// ccd_margin_between() wherever their boxes come that close), and its swept box widened by
+  /// it; empty for skipped objects.
+  std::vector<std::vector<double>> shares;
   std::vector<std::vector<AABB>> triangles;
   std::vector<AABB> objects;  ///< union of an object's swept triangle boxes
   /// [object][vertex] the segment from the vertex's start to its end position, boxed (not

@@ -26,7 +26,6 @@ constexpr Index kChunk = 256;  // triangles per work item: enough items to balan
 /// The sum of a box's sides.
 double box_size(const AABB& b) { return (b.hi - b.lo).sum(); }
 
-
 }  // namespace
 
 IntersectingPairsOutput intersecting_pairs(const Frame& frame, const IntersectingPairsOptions& opts) {
