@@ -571,7 +571,9 @@ PenetrationDepth finish_depth(PenetrationDepth& pd, double best, const std::vect
 //  - the vertex's own sheet near the contact, R(C): the triangles touching C, and from those
 //    that intersect nothing a flood across edges through triangles that intersect nothing.
 //    The triangles the curve runs through are included where the flood meets them, but not
-//    crossed: the curve bounds R(C). If R(C) holds both triangles of an intersecting pair,
+//    crossed: the curve bounds R(C). From those, R(C) follows the curve: across an edge that
+//    meets a triangle they intersect (the curve passes through that edge) to the triangles
+//    beyond it, which are the same sheet. If R(C) holds both triangles of an intersecting pair,
 //    the curve does not separate the two sheets there (e.g. a triangle-sized fold): the
 //    contact is undecided (status self_intersection).
 //  - T: for each v in C, its nearest point on the object outside R(C), i.e. on the sheet(s)
@@ -603,6 +605,13 @@ PenetrationDepth self_contact_depth(SelfContext& ctx, Index object, const std::v
   hit.erase(std::unique(hit.begin(), hit.end()), hit.end());
   auto is_hit = [&](Index t) { return std::binary_search(hit.begin(), hit.end(), t); };
   pd.overlapping_triangles = {hit, {}};
+  // (triangle, a triangle it intersects), both ways, sorted.
+  std::vector<std::pair<Index, Index>> partners;
+  for (const IntersectingPair& p : pairs) {
+    partners.emplace_back(p.tri_a, p.tri_b);
+    partners.emplace_back(p.tri_b, p.tri_a);
+  }
+  std::sort(partners.begin(), partners.end());
 
   bool undecided = false;
   const Walk walk = walk_from(o, hit, [&](Index v) {
@@ -651,6 +660,31 @@ PenetrationDepth self_contact_depth(SelfContext& ctx, Index object, const std::v
       for (Index e : adj.triangle_edges(t)) {
         if (e == kNoIndex) continue;
         for (Index u : adj.edge_triangles(e)) add(u);
+      }
+    }
+    // Along the curve: an edge of an intersecting triangle of R(C) that meets a triangle the
+    // intersecting triangle meets carries the curve over to the triangles beyond it, which
+    // hold the same sheet's continuation (an edge whose two ends are outside the other sheet
+    // can still pass through it in its middle: the sheet's part inside then runs on across
+    // it). They join R(C), without being crossed themselves in the flood above.
+    for (size_t k = 0; k < region_hits[c].size(); ++k) {
+      const Index t = region_hits[c][k];
+      const auto [lo, hi] = std::equal_range(partners.begin(), partners.end(), std::pair<Index, Index>{t, kNoIndex},
+                                             [](const auto& x, const auto& y) { return x.first < y.first; });
+      for (Index e : adj.triangle_edges(t)) {
+        if (e == kNoIndex) continue;
+        const auto& ends = adj.edges()[static_cast<size_t>(e)];
+        const Vec3& p0 = o.positions[static_cast<size_t>(ends[0])];
+        const Vec3& p1 = o.positions[static_cast<size_t>(ends[1])];
+        bool carries = false;
+        for (auto it = lo; it != hi && !carries; ++it)
+          carries = segment_triangle_intersection(p0, p1, o.triangle(it->second)).intersecting;
+        if (!carries) continue;
+        for (Index u : adj.edge_triangles(e))
+          if (!in_region(u)) {
+            stamp[static_cast<size_t>(u)] = mark;
+            region_hits[c].push_back(u);
+          }
       }
     }
     for (const IntersectingPair& p : pairs)

@@ -731,6 +731,26 @@ TEST(PenetrationDepthSelf, CoarseMergedBoxesMatchTheTwin) {
   }
 }
 
+TEST(PenetrationDepthSelf, SheetRunningOnAcrossAnEdgeIsNotTheTarget) {
+  // Boxes sharing their x and z side planes, overlapping 0.75 in y; a's bottom face (y =
+  // 0.375, split in four) lies inside b with only its centre strictly inside. As one object,
+  // the triangles of a's sides meet b's sides (coplanar) along the edges of a's bottom face,
+  // which lie in b's side faces: the curve runs over those edges onto a's sides, which are
+  // a's own sheet. Taking them as the other sheet gave the bottom face's corner, 0.71 away
+  // (depth 2.83 along a diagonal), instead of b's bottom, 0.75 below (the twin's answer).
+  const Object a = make_box(Vec3(0.25, 0.375, -2.5), Vec3::Constant(2), 2, "a");
+  const Object b = make_box(Vec3(0.25, -0.875, -2.5), Vec3::Constant(2), 1, "b");
+  const auto twin = run_pd(frame_of({a, b}));
+  const auto self = run_pd(frame_of({merge({a, b}, "ab")}));
+  ASSERT_EQ(twin.size(), 1u);
+  ASSERT_EQ(self.size(), 1u);
+  ASSERT_EQ(twin[0].status, PdStatus::Ok);
+  ASSERT_EQ(self[0].status, PdStatus::Ok) << pd_status_name(self[0].status);
+  EXPECT_EQ(twin[0].depth, 0.75);
+  EXPECT_EQ(self[0].depth, 0.75);
+  EXPECT_LE(std::abs(std::abs(self[0].direction.y()) - 1), 1e-12) << self[0].direction.transpose();
+}
+
 TEST(PenetrationDepthSelf, UndefinedCasesGetAStatus) {
   const BoxPair bp = make_box_pair(0.15);
   {  // one face of A removed: open
