@@ -76,10 +76,9 @@ class ObjParser {
     std::vector<MeshGroup> out;
     if (mode == ObjGroups::Merge || with_faces.size() <= 1) {
       MeshGroup one;
-      one.name =
-          (with_faces.size() == 1 && !with_faces[0]->name.empty() && mode == ObjGroups::Split)
-              ? with_faces[0]->name
-              : stem;
+      const bool named = with_faces.size() == 1 && !with_faces[0]->name.empty() && mode == ObjGroups::Split;
+      one.name = named ? with_faces[0]->name : stem;
+      if (!named) one.unnamed = 0;
       one.positions = std::move(positions_);
       // Groups follow each other in the file, so concatenating them keeps file order.
       std::size_t n = 0;
@@ -104,6 +103,7 @@ class ObjParser {
       used.erase(std::unique(used.begin(), used.end()), used.end());
       MeshGroup mg;
       mg.name = g.name.empty() ? stem + "_" + std::to_string(k) : g.name;
+      if (g.name.empty()) mg.unnamed = static_cast<int>(k);
       mg.positions.reserve(used.size());
       for (std::size_t i = 0; i < used.size(); ++i) {
         local[static_cast<std::size_t>(used[i])] = static_cast<Index>(i);

@@ -508,6 +508,7 @@ MeshGroup read_ply(const fs::path& file) {
 
   MeshGroup out;
   out.name = file.stem().string();
+  out.unnamed = 0;
   Where where;
   where.file = &file;
   if (h.format == Format::Ascii) {

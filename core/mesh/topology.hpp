@@ -33,11 +33,29 @@ class AdjacencyCache {
 /// and, per vertex of the component, its index among the mesh's vertices. Empty for an object
 /// that is a whole mesh. CCD pairs a component with the component of the next frame that holds
 /// the same vertices of the same mesh (its name "<mesh>#k" only numbers the pieces).
+///
+/// A mesh the file gives no name of its own (a PLY or OFF file, an OBJ without groups or its
+/// faces before the first group, an unnamed assimp mesh) is named after the file, and the file
+/// name changes from frame to frame: such a mesh is identified by its position among the
+/// file's meshes (`unnamed_mesh`) instead of by its name.
 struct ComponentOrigin {
-  std::string mesh;
+  std::string mesh;       ///< the mesh's name (for messages; identifies it when unnamed_mesh < 0)
+  int unnamed_mesh = -1;  ///< the mesh's position in its file when the file does not name it
   std::vector<Index> vertices;
   bool empty() const { return vertices.empty(); }
-  bool operator==(const ComponentOrigin& o) const { return vertices == o.vertices && mesh == o.mesh; }
+  /// Whether both come from the same mesh: same position when the file names neither, else
+  /// the same name.
+  bool same_mesh(const ComponentOrigin& o) const {
+    if (unnamed_mesh >= 0 || o.unnamed_mesh >= 0) return unnamed_mesh == o.unnamed_mesh;
+    return mesh == o.mesh;
+  }
+  /// Orders origins by mesh (as same_mesh() identifies it), then vertices.
+  bool operator<(const ComponentOrigin& o) const {
+    if (unnamed_mesh != o.unnamed_mesh) return unnamed_mesh < o.unnamed_mesh;
+    if (unnamed_mesh < 0 && mesh != o.mesh) return mesh < o.mesh;
+    return vertices < o.vertices;
+  }
+  bool operator==(const ComponentOrigin& o) const { return vertices == o.vertices && same_mesh(o); }
   bool operator!=(const ComponentOrigin& o) const { return !(*this == o); }
 };
 

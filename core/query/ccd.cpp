@@ -413,9 +413,8 @@ bool is_component(const Object& o) { return o.topology && !o.topology->origin.em
 /// Orders components by what identifies them across frames: static or not, mesh, vertices.
 struct ComponentLess {
   bool operator()(const Object* a, const Object* b) const {
-    const ComponentOrigin& x = a->topology->origin;
-    const ComponentOrigin& y = b->topology->origin;
-    return std::tie(a->is_static, x.mesh, x.vertices) < std::tie(b->is_static, y.mesh, y.vertices);
+    if (a->is_static != b->is_static) return a->is_static < b->is_static;
+    return a->topology->origin < b->topology->origin;
   }
 };
 

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <sstream>
 
 namespace vproxq {
 namespace {
@@ -346,6 +347,82 @@ TEST(CcdCli, RenumberedPiecesKeepTheirCollisions) {
   EXPECT_EQ(got[0]["pairs"], got[1]["pairs"]);
   EXPECT_EQ(got[0]["vf"], got[1]["vf"]);
   EXPECT_EQ(got[0]["ee"], got[1]["ee"]);
+}
+
+// Meshes the file does not name (a PLY or OFF file, an OBJ without groups, faces before the
+// first OBJ group) are named after the file, which changes from frame to frame: their pieces
+// are matched by the mesh's position in the file instead, so the usual frames/x_%04d.ply
+// layout keeps its collisions. The same step through two files of one name is the reference.
+TEST(CcdCli, PiecesOfMeshesNamedAfterTheirFileAreMatched) {
+  ScratchDir dir;
+  auto tet = [](double x) {
+    std::vector<Vec3> v;
+    for (const auto& d : {Vec3(0, 0, 0), Vec3(0.8, 0, 0), Vec3(0, 0.8, 0), Vec3(0, 0, 0.8)}) v.push_back(Vec3(x, 0, 0) + d);
+    return v;
+  };
+  const std::vector<std::array<int, 3>> tet_faces = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  // Piece 0 moves from x = 0 to x = 4 through piece 1 at x = 2; piece 2 stays apart.
+  auto points = [&](double x0) {
+    std::vector<Vec3> v;
+    for (double x : {x0, 2.0, 6.0})
+      for (const Vec3& p : tet(x)) v.push_back(p);
+    return v;
+  };
+  auto obj = [&](const std::vector<Vec3>& v, const std::string& header, int grouped_from) {
+    std::ostringstream out;
+    out.precision(17);
+    out << header;
+    for (const Vec3& p : v) out << "v " << p.x() << " " << p.y() << " " << p.z() << "\n";
+    for (int t = 0; t < 3; ++t) {
+      if (t == grouped_from) out << "o named\n";
+      for (const auto& f : tet_faces) out << "f " << 4 * t + f[0] + 1 << " " << 4 * t + f[1] + 1 << " " << 4 * t + f[2] + 1 << "\n";
+    }
+    return out.str();
+  };
+  auto ply = [&](const std::vector<Vec3>& v) {
+    std::ostringstream out;
+    out.precision(17);
+    out << "ply\nformat ascii 1.0\nelement vertex " << v.size()
+        << "\nproperty double x\nproperty double y\nproperty double z\nelement face 12\n"
+           "property list uchar int vertex_indices\nend_header\n";
+    for (const Vec3& p : v) out << p.x() << " " << p.y() << " " << p.z() << "\n";
+    for (int t = 0; t < 3; ++t)
+      for (const auto& f : tet_faces) out << "3 " << 4 * t + f[0] << " " << 4 * t + f[1] << " " << 4 * t + f[2] << "\n";
+    return out.str();
+  };
+  // (files of frame 0 and 1, same-name files for the reference); grouped_from 3: no group.
+  struct Layout {
+    const char* what;
+    std::string a, b, ref_a, ref_b, text_a, text_b;
+  };
+  const std::vector<Layout> layouts = {
+      {"ungrouped OBJ", "x_0000.obj", "x_0001.obj", "a/x.obj", "b/x.obj", obj(points(0), "", 3), obj(points(4), "", 3)},
+      {"faces before the first OBJ group", "y_0000.obj", "y_0001.obj", "c/y.obj", "d/y.obj", obj(points(0), "", 2),
+       obj(points(4), "", 2)},
+      {"PLY", "z_0000.ply", "z_0001.ply", "e/z.ply", "f/z.ply", ply(points(0)), ply(points(4))},
+  };
+  for (const Layout& l : layouts) {
+    SCOPED_TRACE(l.what);
+    for (const auto& [file, text] : {std::pair{l.a, l.text_a}, {l.b, l.text_b}, {l.ref_a, l.text_a}, {l.ref_b, l.text_b}}) {
+      fs::create_directories((dir / file).parent_path());
+      dir.write(file, text);
+    }
+    nlohmann::json got[2];
+    for (int k = 0; k < 2; ++k) {
+      const std::string files = k ? "\"" + l.ref_a + "\", \"" + l.ref_b + "\"" : "\"" + l.a + "\", \"" + l.b + "\"";
+      const auto scene = dir.write("s.json", R"({"frames": {"files": [)" + files + R"(]}, "objects": "components"})");
+      const fs::path out = dir / ("out_" + std::string(l.a) + std::to_string(k));
+      const auto r = vproxq(quote(scene) + " --queries ccd --quiet -o " + quote(out));
+      ASSERT_EQ(r.exit_code, 0) << r.output;
+      got[k] = read_json(out / "results.json")["frames"][0]["ccd"];
+      EXPECT_TRUE(got[k]["skipped"].empty()) << got[k].dump();
+    }
+    ASSERT_EQ(got[0]["pairs"].size(), 1u) << got[0].dump();
+    EXPECT_EQ(got[0]["pairs"][0]["objects"], nlohmann::json::parse("[0, 1]")) << got[0].dump();
+    EXPECT_EQ(got[0]["pairs"], got[1]["pairs"]);
+    EXPECT_EQ(got[0]["vf"], got[1]["vf"]);
+    EXPECT_EQ(got[0]["ee"], got[1]["ee"]);
+  }
 }
 
 }  // namespace
