@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -16,6 +17,7 @@
 #include <exception>
 #include <new>
 #include <string>
+#include <vector>
 
 namespace vproxq {
 namespace {
@@ -51,6 +53,25 @@ FrameRange parse_frame_range(const std::string& text) {
   if (r.last && *r.last <= r.first.value_or(0))
     throw UsageError("--frames " + text + ": the range is empty (B is exclusive and must exceed A)");
   return r;
+}
+
+/// Splits --queries' comma-separated value. Empty items and repeats are usage errors, as
+/// repeats are in scene.json's "queries"; unknown names are checked with the scene's list.
+std::vector<std::string> parse_query_list(const std::string& text) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    if (item.empty())
+      throw UsageError("--queries '" + text + "': " + (text.empty() ? "no query given" : "an empty item") +
+                       "; expected comma-separated names from: " + query_names_list());
+    if (std::find(out.begin(), out.end(), item) != out.end())
+      throw UsageError("--queries '" + text + "': '" + item + "' is given twice");
+    out.push_back(item);
+    if (comma == std::string::npos) return out;
+    start = comma + 1;
+  }
 }
 
 /// An option value that must be a whole number in [lo, hi]: the message names the range and
@@ -118,6 +139,18 @@ int guarded(F&& body) {
 
 int parse_or_exit(CLI::App& app, int argc, char** argv, bool& done) {
   done = false;
+  // CLI11 reads `--name=` (nothing after the '=') as `--name` and takes the next argument as
+  // its value: `--queries= SCENE` would then report SCENE missing, or an unknown query '-q'.
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--") break;
+    if (arg.size() > 3 && arg.compare(0, 2, "--") == 0 && arg.back() == '=' && arg.find('=') == arg.size() - 1) {
+      done = true;
+      std::fprintf(stderr, "vproxq: usage error: %s has no value\nRun with --help for the options.\n",
+                   arg.substr(0, arg.size() - 1).c_str());
+      return exit_code::kUsage;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -195,11 +228,12 @@ int cli_main(int argc, char** argv) {
   std::string frames;
   app.add_option("SCENE", config.scene_path, "scene.json, or a mesh file (a one-frame scene)")
       ->required();
-  app.add_option("--queries", config.queries,
+  // One value, split here: a list option would take the next argument when the value has no
+  // item (`--queries=, SCENE`), and would drop empty items and repeats without a word.
+  std::string queries;
+  app.add_option("--queries", queries,
                  "comma-separated queries to run (default: the scene's \"queries\", else "
-                 "distance). Valid: " + query_names_list())
-      ->delimiter(',')
-      ->allow_extra_args(false);  // one comma-separated value: `--queries=distance SCENE` keeps SCENE
+                 "distance). Valid: " + query_names_list());
   app.add_option("-o,--output", config.output_dir,
                  "write OUT/results.json and OUT/results.h5 (default: print a summary)")
       ->check([](const std::string& dir) { return dir.empty() ? std::string("the output directory must not be empty") : std::string(); });
@@ -227,6 +261,7 @@ int cli_main(int argc, char** argv) {
   if (done) return code;
   return guarded([&] {
     if (!frames.empty()) config.frames = parse_frame_range(frames);
+    if (app.count("--queries") > 0) config.queries = parse_query_list(queries);
     g_out_of_memory_hint = config.voronoi == "off" ? "" : "; a coarser --grid (or --voronoi=off) needs less";
     // Options that the chosen backend does not use: said once, so that a sweep over --grid
     // with the default --voronoi=off does not silently measure the same run again and again.

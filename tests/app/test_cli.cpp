@@ -96,6 +96,21 @@ TEST(Cli, UsageErrors) {
   EXPECT_NE(r.output.find("valid queries: distance, ccd, pd"), std::string::npos) << r.output;
   r = vproxq(scene + " --queries=,");
   EXPECT_EQ(r.exit_code, 2) << r.output;
+  // Empty items and repeats are errors (as in scene.json), and a value with no item does not
+  // take the next argument as its own: the message is about --queries.
+  for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+           {scene + " --queries=distance,distance", "'distance' is given twice"},
+           {scene + " --queries=,distance", "an empty item"},
+           {scene + " --queries=distance,,pd", "an empty item"},
+           {scene + " --queries=, -q", "--queries ',': an empty item"},
+           {"--queries=, " + scene, "--queries ',': an empty item"},
+           {scene + " --queries= -q", "--queries has no value"},
+           {scene + " --frames= -q", "--frames has no value"}}) {
+    SCOPED_TRACE(args);
+    r = vproxq(args);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find(says), std::string::npos) << r.output;
+  }
   r = vproxq(scene + " --voronoi=sometimes");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   // Numeric options name their range and the value given.
