@@ -5,6 +5,7 @@
 #include "core/timer.hpp"
 #include "core/voronoi/bins.hpp"
 #include "core/voronoi/grid_setup.hpp"
+#include "core/voronoi/radix_sort.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -158,14 +159,16 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
     }
   });
   std::vector<Sample> samples;
+  std::uint64_t max_voxel = 0;
   for (size_t i = 0; i < n; ++i) {
     samples.insert(samples.end(), hits[i].begin(), hits[i].end());
     out.sampled_triangles += sampled[i];
+    for (const Sample& s : hits[i]) max_voxel = std::max(max_voxel, static_cast<std::uint64_t>(s.voxel));
   }
   hits.clear();
-  std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) {
-    return a.voxel != b.voxel ? a.voxel < b.voxel : a.triangle < b.triangle;
-  });
+  // Samples are in triangle order (objects in order, each object's triangles ascending): a
+  // stable sort by voxel orders them by (voxel, triangle).
+  stable_radix_sort(samples, max_voxel, [](const Sample& s) { return static_cast<std::uint64_t>(s.voxel); });
 
   // Bands: f needs exact values up to its 2-ring bound + δ (+ slack): below that a value can
   // improve D_u(f), and a capped value then gives D_l(f) = band - δ >= the 2-ring bound, which

@@ -4,10 +4,12 @@
 #include "core/timer.hpp"
 #include "core/voronoi/bins.hpp"
 #include "core/voronoi/grid_setup.hpp"
+#include "core/voronoi/radix_sort.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <stdexcept>
 
 namespace vproxq {
 namespace {
@@ -82,15 +84,23 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
     std::int64_t voxel;
     float band;
     std::int32_t object;
+    std::uint32_t hit;  ///< position among all objects' hits (object order)
   };
   std::vector<VoxelBand> vb;
-  size_t total_hits = 0;
-  for (const auto& h : hits) total_hits += h.size();
-  vb.reserve(total_hits);
+  std::vector<size_t> hit_base(n + 1, 0);
+  for (size_t i = 0; i < n; ++i) hit_base[i + 1] = hit_base[i] + hits[i].size();
+  if (hit_base[n] >= (std::uint64_t{1} << 32))
+    throw std::length_error("Stage II: more than 2^32 voxel marks; use a coarser --grid");
+  vb.reserve(hit_base[n]);
+  std::uint64_t max_voxel = 0;
   for (size_t i = 0; i < n; ++i)
-    for (const auto& h : hits[i])
-      vb.push_back({h.voxel, obj_band[i], static_cast<std::int32_t>(i)});
-  std::sort(vb.begin(), vb.end(), [](const auto& a, const auto& b) { return a.voxel < b.voxel; });
+    for (size_t j = 0; j < hits[i].size(); ++j) {
+      vb.push_back({hits[i][j].voxel, obj_band[i], static_cast<std::int32_t>(i), static_cast<std::uint32_t>(hit_base[i] + j)});
+      max_voxel = std::max(max_voxel, static_cast<std::uint64_t>(hits[i][j].voxel));
+    }
+  stable_radix_sort(vb, max_voxel, [](const VoxelBand& x) { return static_cast<std::uint64_t>(x.voxel); });
+  // The sample each hit was merged into, for the scan.
+  std::vector<std::uint32_t> hit_sample(hit_base[n]);
   for (size_t k = 0; k < vb.size();) {
     size_t e = k;
     float band = 0;
@@ -98,6 +108,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
     for (; e < vb.size() && vb[e].voxel == vb[k].voxel; ++e) {
       band = std::max(band, vb[e].band);
       one_site = one_site && vb[e].object == vb[k].object;
+      hit_sample[vb[e].hit] = static_cast<std::uint32_t>(in.voxels.size());
     }
     in.voxels.push_back(vb[k].voxel);
     in.band.push_back(band);
@@ -125,9 +136,9 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
     double sd_obj_usable = kInfinity;  // min over values below their band
     auto& lower = out.triangle_lower[i];
     std::vector<double> sd_tri(lower.size(), kInfinity);
-    for (const auto& h : hits[i]) {
-      const size_t k = static_cast<size_t>(
-          std::lower_bound(in.voxels.begin(), in.voxels.end(), h.voxel) - in.voxels.begin());
+    for (size_t j = 0; j < hits[i].size(); ++j) {
+      const auto& h = hits[i][j];
+      const size_t k = hit_sample[hit_base[i] + j];
       const bool first_is_self = dvd.site1[k] == static_cast<std::int32_t>(i);
       const std::int32_t site = first_is_self ? dvd.site2[k] : dvd.site1[k];
       const double v = sg.unit * (first_is_self ? dvd.dist2[k] : dvd.dist1[k]);
