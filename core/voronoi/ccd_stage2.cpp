@@ -58,6 +58,11 @@ constexpr double kCellFactor = 0.5;
 /// Upper bound on the estimated voxels visited per (triangle, slot) record, on average (the
 /// 200-blob scene visits ~17 with the factor above; the bound only bites on mixed sizes).
 constexpr double kRoomPerRecord = 80;
+/// The same bound for a grid given by --grid: it honours the grid unless the records would
+/// cover some thousands of voxels each (a small scene far from the origin, where the culling
+/// margin dwarfs the triangles: at 1e12, --grid 128 took over 60 s and 19 GB, 200 ran out of
+/// memory; with --grid 4096 on any scene, the same).
+constexpr double kRoomPerRecordGiven = 64 * kRoomPerRecord;
 
 std::int64_t floor_div(std::int64_t a, std::int64_t b) {  // b > 0
   const std::int64_t q = a / b;
@@ -237,9 +242,7 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
   // Cell. By default about the size of a triangle's box over one slot (median over the
   // step): coarser cells cannot separate neighbours, finer ones multiply the marks.
   double cell;
-  if (options.grid_resolution > 0) {
-    cell = longest / options.grid_resolution;
-  } else {
+  {
     std::vector<double> size(static_cast<size_t>(total_tris));
     parallel_for((static_cast<size_t>(total_tris) + kChunk - 1) / kChunk, threads, [&](size_t c) {
       const std::int64_t end = std::min<std::int64_t>(total_tris, static_cast<std::int64_t>((c + 1) * kChunk));
@@ -254,10 +257,14 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
         size[static_cast<size_t>(t)] = ((b0.hi - b0.lo).cwiseMax(b1.hi - b1.lo) + motion / K).maxCoeff();
       }
     });
-    auto mid = size.begin() + static_cast<std::ptrdiff_t>(size.size() / 2);
-    std::nth_element(size.begin(), mid, size.end());
-    cell = kCellFactor * *mid;
-    if (!(cell > 0) || !std::isfinite(cell)) cell = longest / 32;
+    if (options.grid_resolution > 0) {
+      cell = longest / options.grid_resolution;
+    } else {
+      auto mid = size.begin() + static_cast<std::ptrdiff_t>(size.size() / 2);
+      std::nth_element(size.begin(), mid, size.end());
+      cell = kCellFactor * *mid;
+      if (!(cell > 0) || !std::isfinite(cell)) cell = longest / 32;
+    }
     // Budget: a few large triangles (a static floor or funnel next to a fine cloth) would
     // otherwise cover millions of voxels each. Estimate the voxels the records will visit
     // (a cube of a triangle's per-slot size widened by the culling margin on both sides, plus
@@ -265,10 +272,11 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
     // (The margin grows with the coordinates' magnitude: far from the origin it can exceed
     // the triangles themselves.)
     cell = std::max(cell, longest / (kMaxDim - 2));
+    const double budget = options.grid_resolution > 0 ? kRoomPerRecordGiven : kRoomPerRecord;
     for (int attempt = 0; attempt < 64; ++attempt) {
       double room = 0;
       for (double d : size) room += std::pow(std::min((d + 2 * sweep.margin) / cell, double{kMaxDim}) + 2, 3);
-      if (room <= kRoomPerRecord * static_cast<double>(size.size())) break;
+      if (room <= budget * static_cast<double>(size.size())) break;
       cell *= 1.25;
     }
   }
