@@ -146,10 +146,13 @@ std::vector<MeshGroup> read_with_assimp(const fs::path& file) {
     groups.push_back(convert(file, mesh, ref, stl));
   }
   const std::string stem = file.stem().string();
+  // The only unnamed mesh of a file is identified across frames as such (ComponentOrigin);
+  // of several, none is.
+  const auto unnamed = std::count_if(groups.begin(), groups.end(), [](const MeshGroup& g) { return g.name.empty(); });
   for (std::size_t k = 0; k < groups.size(); ++k) {
     if (groups[k].name.empty()) {
       groups[k].name = groups.size() == 1 ? stem : stem + "_" + std::to_string(k);
-      groups[k].unnamed = static_cast<int>(k);
+      if (unnamed == 1) groups[k].unnamed = 0;
     }
   }
   return groups;

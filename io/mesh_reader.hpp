@@ -15,8 +15,8 @@ struct MeshGroup {
   std::string name;
   std::vector<Vec3> positions;
   std::vector<Face> faces;
-  /// The mesh's position among its file's meshes when the file gives it no name of its own
-  /// (`name` is then made from the file's name), else -1. See ComponentOrigin.
+  /// 0 when this is the only mesh of its file that the file gives no name of its own (`name` is
+  /// then made from the file's name), else -1. See ComponentOrigin.
   int unnamed = -1;
   /// Set by split_components(): the mesh this component was cut from (core/mesh/topology.hpp).
   ComponentOrigin origin;

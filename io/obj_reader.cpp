@@ -95,6 +95,9 @@ class ObjParser {
     // proportional to the face corners, not groups x vertices.
     std::vector<Index> local(positions_.size(), kNoIndex);
     std::vector<Index> used;
+    // An unnamed group is identified across frames by being the file's only one (see
+    // ComponentOrigin); of several, none is (position could pair different meshes).
+    const auto unnamed = std::count_if(with_faces.begin(), with_faces.end(), [](const RawGroup* g) { return g->name.empty(); });
     for (std::size_t k = 0; k < with_faces.size(); ++k) {
       RawGroup& g = *with_faces[k];
       used.clear();
@@ -103,7 +106,7 @@ class ObjParser {
       used.erase(std::unique(used.begin(), used.end()), used.end());
       MeshGroup mg;
       mg.name = g.name.empty() ? stem + "_" + std::to_string(k) : g.name;
-      if (g.name.empty()) mg.unnamed = static_cast<int>(k);
+      if (g.name.empty() && unnamed == 1) mg.unnamed = 0;
       mg.positions.reserve(used.size());
       for (std::size_t i = 0; i < used.size(); ++i) {
         local[static_cast<std::size_t>(used[i])] = static_cast<Index>(i);

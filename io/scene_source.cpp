@@ -433,6 +433,7 @@ void parse_scene_json(SceneImpl& s) {
       }
       if (count_faces(groups) == 0) p.fail(key, "has no triangles: " + file.string());
       for (MeshGroup& g : split_groups(std::move(groups), split)) {
+        if (!g.origin.empty()) g.origin.static_file = static_cast<int>(i);
         Object obj;
         obj.name = g.name;
         obj.topology = std::make_shared<const Topology>(make_topology(g));

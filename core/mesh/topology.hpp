@@ -34,23 +34,29 @@ class AdjacencyCache {
 /// that is a whole mesh. CCD pairs a component with the component of the next frame that holds
 /// the same vertices of the same mesh (its name "<mesh>#k" only numbers the pieces).
 ///
-/// A mesh the file gives no name of its own (a PLY or OFF file, an OBJ without groups or its
-/// faces before the first group, an unnamed assimp mesh) is named after the file, and the file
-/// name changes from frame to frame: such a mesh is identified by its position among the
-/// file's meshes (`unnamed_mesh`) instead of by its name.
+/// A mesh the file gives no name of its own (a PLY or OFF file, an OBJ without groups, an
+/// unnamed OBJ group, an unnamed assimp mesh) is named after the file, and the file name
+/// changes from frame to frame: when it is the file's only unnamed mesh, it is identified as
+/// that (`unnamed_mesh` 0) instead of by its name. (Of several unnamed meshes in one file,
+/// none is: pairing them by position would read a mesh that vanished and its neighbour as
+/// one moving mesh.) Meshes of the scene's static files are also told apart by the file
+/// (`static_file`).
 struct ComponentOrigin {
   std::string mesh;       ///< the mesh's name (for messages; identifies it when unnamed_mesh < 0)
-  int unnamed_mesh = -1;  ///< the mesh's position in its file when the file does not name it
+  int unnamed_mesh = -1;  ///< 0 for the only mesh its file does not name, else -1
+  int static_file = -1;   ///< for static geometry, the position of its file in "static"
   std::vector<Index> vertices;
   bool empty() const { return vertices.empty(); }
-  /// Whether both come from the same mesh: same position when the file names neither, else
-  /// the same name.
+  /// Whether both come from the same mesh: the same static file (or none), then the same
+  /// position among the unnamed meshes when the file names neither, else the same name.
   bool same_mesh(const ComponentOrigin& o) const {
+    if (static_file != o.static_file) return false;
     if (unnamed_mesh >= 0 || o.unnamed_mesh >= 0) return unnamed_mesh == o.unnamed_mesh;
     return mesh == o.mesh;
   }
   /// Orders origins by mesh (as same_mesh() identifies it), then vertices.
   bool operator<(const ComponentOrigin& o) const {
+    if (static_file != o.static_file) return static_file < o.static_file;
     if (unnamed_mesh != o.unnamed_mesh) return unnamed_mesh < o.unnamed_mesh;
     if (unnamed_mesh < 0 && mesh != o.mesh) return mesh < o.mesh;
     return vertices < o.vertices;

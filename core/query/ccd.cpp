@@ -508,7 +508,9 @@ CcdParticipants ccd_participants(const Frame& from, const Frame& to) {
     const Object& b = to.objects[i];
     if (!b.topology) {
       if (is_component(a))
-        p.skipped.push_back({id, "no piece of '" + a.topology->origin.mesh + "' in frame " + std::to_string(to.index) +
+        // The mesh's name from the piece's own "<mesh>#k" (a topology kept from an earlier
+        // frame keeps that frame's name of a mesh named after its file).
+        p.skipped.push_back({id, "no piece of '" + a.name.substr(0, a.name.rfind('#')) + "' in frame " + std::to_string(to.index) +
                                      " holds the same vertices (" + kPieceRule + ")"});
       else
         p.skipped.push_back({id, "no object named '" + a.name + "' in frame " + std::to_string(to.index)});

@@ -425,5 +425,62 @@ TEST(CcdCli, PiecesOfMeshesNamedAfterTheirFileAreMatched) {
   }
 }
 
+// Meshes the files do not name must not be taken for one another: two static PLY files (both
+// hold their file's only unnamed mesh) are told apart by the file, and of several unnamed
+// OBJ groups in one file none is matched (by position, a group that vanished and its
+// neighbour would read as one moving mesh). Nothing here moves: any pair is a phantom.
+TEST(CcdCli, UnnamedMeshesAreNotTakenForOneAnother) {
+  ScratchDir dir;
+  auto tet = [](double x, double y) {
+    std::string v;
+    for (const auto& d : {std::array<double, 3>{0, 0, 0}, {0.8, 0, 0}, {0, 0.8, 0}, {0, 0, 0.8}})
+      v += "v " + std::to_string(x + d[0]) + " " + std::to_string(y + d[1]) + " " + std::to_string(d[2]) + "\n";
+    return v;
+  };
+  const std::string faces = "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  auto ply = [&](double x) {
+    std::string out = "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\n"
+                      "property double z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n";
+    std::string v = tet(x, 5);
+    for (std::size_t at; (at = v.find("v ")) != std::string::npos;) v.erase(at, 2);
+    return out + v + "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  };
+  dir.write("s1.ply", ply(0));
+  dir.write("s2.ply", ply(3));
+  // The named mesh loses its first piece: the second is skipped (its vertices' indices
+  // changed; the first piece's indices now hold it, which reads as that piece moving), and the
+  // statics behind it change places in the object list: each must find its own file's.
+  dir.write("d0.obj", "o m\n" + tet(0, 0) + tet(3, 0) + faces + "f 5 7 6\nf 5 6 8\nf 5 8 7\nf 6 7 8\n");
+  dir.write("d1.obj", "o m\n" + tet(3, 0) + faces);
+  auto group = [&](const std::string& g, double x, int base) {
+    std::string f;
+    for (const auto& t : {std::array<int, 3>{1, 3, 2}, {1, 2, 4}, {1, 4, 3}, {2, 3, 4}})
+      f += "f " + std::to_string(base + t[0]) + " " + std::to_string(base + t[1]) + " " + std::to_string(base + t[2]) + "\n";
+    return std::pair{tet(x, 0), g + "\n" + f};
+  };
+  // Frame 0: bare groups X (x = 0), Y (x = 3), then Z (x = 6); frame 1 drops X.
+  const auto [xv, xf] = group("g", 0, 0);
+  const auto [yv, yf] = group("g", 3, 4);
+  const auto [zv, zf] = group("g Z", 6, 8);
+  dir.write("u0.obj", xv + yv + zv + xf + yf + zf);
+  const auto [yv1, yf1] = group("g", 3, 0);
+  const auto [zv1, zf1] = group("g Z", 6, 4);
+  dir.write("u1.obj", yv1 + zv1 + yf1 + zf1);
+  for (const auto& [scene_text, expected_skipped] : std::vector<std::pair<std::string, std::vector<int>>>{
+           {R"({"frames": {"files": ["d0.obj", "d1.obj"]}, "objects": "components", "static": ["s1.ply", "s2.ply"]})", {1}},
+           {R"({"frames": {"files": ["u0.obj", "u1.obj"]}, "objects": "components"})", {0, 1}}}) {
+    SCOPED_TRACE(scene_text);
+    const auto scene = dir.write("s.json", scene_text);
+    const fs::path out = dir / ("out" + std::to_string(scene_text.size()));
+    const auto r = vproxq(quote(scene) + " --queries ccd --quiet -o " + quote(out));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const auto ccd = read_json(out / "results.json")["frames"][0]["ccd"];
+    EXPECT_TRUE(ccd["pairs"].empty()) << ccd.dump();
+    std::vector<int> skipped;
+    for (const auto& sk : ccd["skipped"]) skipped.push_back(sk["object"].get<int>());
+    EXPECT_EQ(skipped, expected_skipped) << ccd.dump();
+  }
+}
+
 }  // namespace
 }  // namespace vproxq
