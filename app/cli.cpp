@@ -57,21 +57,24 @@ FrameRange parse_frame_range(const std::string& text) {
 
 /// Splits --queries' comma-separated value. Empty items and repeats are usage errors, as
 /// repeats are in scene.json's "queries"; unknown names are checked with the scene's list.
-std::vector<std::string> parse_query_list(const std::string& text) {
+std::vector<std::string> parse_query_list(const std::vector<std::string>& values) {
   std::vector<std::string> out;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t comma = text.find(',', start);
-    const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    if (item.empty())
-      throw UsageError("--queries '" + text + "': " + (text.empty() ? "no query given" : "an empty item") +
-                       "; expected comma-separated names from: " + query_names_list());
-    if (std::find(out.begin(), out.end(), item) != out.end())
-      throw UsageError("--queries '" + text + "': '" + item + "' is given twice");
-    out.push_back(item);
-    if (comma == std::string::npos) return out;
-    start = comma + 1;
+  for (const std::string& text : values) {
+    std::size_t start = 0;
+    while (true) {
+      const std::size_t comma = text.find(',', start);
+      const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+      if (item.empty())
+        throw UsageError("--queries '" + text + "': " + (text.empty() ? "no query given" : "an empty item") +
+                         "; expected comma-separated names from: " + query_names_list());
+      if (std::find(out.begin(), out.end(), item) != out.end())
+        throw UsageError("--queries: '" + item + "' is given twice");
+      out.push_back(item);
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
   }
+  return out;
 }
 
 /// An option value that must be a whole number in [lo, hi]: the message names the range and
@@ -228,12 +231,14 @@ int cli_main(int argc, char** argv) {
   std::string frames;
   app.add_option("SCENE", config.scene_path, "scene.json, or a mesh file (a one-frame scene)")
       ->required();
-  // One value, split here: a list option would take the next argument when the value has no
-  // item (`--queries=, SCENE`), and would drop empty items and repeats without a word.
-  std::string queries;
+  // Values split here, not by CLI11: its list splitting took the next argument when the value
+  // had no item (`--queries=, SCENE`), and dropped empty items and repeats without a word.
+  // The option may be given more than once; its lists are joined.
+  std::vector<std::string> queries;
   app.add_option("--queries", queries,
                  "comma-separated queries to run (default: the scene's \"queries\", else "
-                 "distance). Valid: " + query_names_list());
+                 "distance). Valid: " + query_names_list())
+      ->allow_extra_args(false);
   app.add_option("-o,--output", config.output_dir,
                  "write OUT/results.json and OUT/results.h5 (default: print a summary)")
       ->check([](const std::string& dir) { return dir.empty() ? std::string("the output directory must not be empty") : std::string(); });

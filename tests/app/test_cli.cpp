@@ -100,6 +100,7 @@ TEST(Cli, UsageErrors) {
   // take the next argument as its own: the message is about --queries.
   for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
            {scene + " --queries=distance,distance", "'distance' is given twice"},
+           {scene + " --queries distance --queries pd,distance", "'distance' is given twice"},
            {scene + " --queries=,distance", "an empty item"},
            {scene + " --queries=distance,,pd", "an empty item"},
            {scene + " --queries=, -q", "--queries ',': an empty item"},
@@ -110,6 +111,14 @@ TEST(Cli, UsageErrors) {
     r = vproxq(args);
     EXPECT_EQ(r.exit_code, 2) << r.output;
     EXPECT_NE(r.output.find(says), std::string::npos) << r.output;
+  }
+  // The option may be repeated: its lists are joined.
+  {
+    ScratchDir dir;
+    r = vproxq(scene + " --queries distance --queries pd --quiet -o " + quote(dir / "out"));
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    const auto frame = read_json(dir / "out" / "results.json")["frames"][0];
+    EXPECT_TRUE(frame.contains("distance") && frame.contains("pd")) << frame.dump().substr(0, 300);
   }
   r = vproxq(scene + " --voronoi=sometimes");
   EXPECT_EQ(r.exit_code, 2) << r.output;
