@@ -2,14 +2,18 @@
 # vproxq against FCL on the paper's "200 objects through a funnel" scene, in one command:
 # installs libfcl-dev if missing (as root or through sudo), configures a Release build with
 # the benchmark into build-bench/, builds it, generates the scene into bench-out/, and runs
-# the benchmark, printing the per-frame table (also saved as bench-out/blobs-200/fcl-bench.txt).
+# the benchmark, printing the per-frame table (also saved as bench-out/blobs-200/fcl-bench.txt):
+# vproxq's inter-object distance with each Stage II backend (off, cpu, gpu) and FCL's, side by
+# side, on the same frames (gpu: Mesa's llvmpipe on a machine without a GPU; left out with a
+# note where no EGL context can be made).
 #
 #   bash scripts/bench.sh                      # 200 blobs x 180 triangles, 5 frames, 2 threads
 #   THREADS=4 REPEAT=5 bash scripts/bench.sh   # environment overrides (see below)
 #   bash scripts/bench.sh --fcl-threads 1      # extra options go to vproxq-bench-fcl
 #
 # Environment: THREADS (2), REPEAT (3), OBJECTS (200), FREQUENCY (3: 180 triangles per blob),
-# FRAMES (5), SEED (1), JOBS (build jobs, default: nproc). The other build dependencies come
+# FRAMES (5), SEED (1), VORONOI (off,cpu,gpu: the backends to time), JOBS (build jobs, default:
+# nproc). The other build dependencies come
 # from scripts/setup.sh.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,6 +24,7 @@ objects=${OBJECTS:-200}
 frequency=${FREQUENCY:-3}
 frames=${FRAMES:-5}
 seed=${SEED:-1}
+voronoi=${VORONOI:-off,cpu,gpu}
 jobs=${JOBS:-$(nproc 2>/dev/null || echo 2)}
 
 # FCL and the other Debian packages: the setup script installs what is missing.
@@ -35,4 +40,4 @@ build-bench/sample_scenes/vproxq-gen blobs --objects "$objects" --frequency "$fr
 
 echo
 build-bench/bench/vproxq-bench-fcl "$scene_dir/scene.json" --threads "$threads" \
-  --repeat "$repeat" "$@" | tee "$scene_dir/fcl-bench.txt"
+  --repeat "$repeat" --voronoi "$voronoi" "$@" | tee "$scene_dir/fcl-bench.txt"
