@@ -189,15 +189,26 @@ TEST(CcdStage2, RandomStepsEqualBruteForceWithEverySlotCount) {
 // the triangles alone made every record's box millions of voxels at 2^42 (out of memory);
 // at 2^33 it made them thousands. Here each record marks a bounded number of voxels and the
 // results equal the brute force.
-TEST(CcdStage2, DefaultCellAllowsForAMarginLargerThanTheTriangles) {
-  Frame from = test::make_random_frame(3, 3, 2.0, 1);
-  for (Object& o : from.objects)
-    for (Vec3& p : o.positions) p += Vec3(std::ldexp(1.0, 33), 0, 0);
-  from.index = 0;
-  const Frame to = moved(from, 5, 0.6, 0.1);
-  const CcdSweep sweep = CcdSweep::compute(from, to, 2);
+/// A random step of 3 small objects moved by 2^33 along x (or not), and its triangle count.
+struct OffsetStep {
+  Frame from, to;
   std::size_t triangles = 0;
-  for (const Object& o : from.objects) triangles += static_cast<std::size_t>(o.num_triangles());
+  explicit OffsetStep(double offset) : from(test::make_random_frame(3, 3, 2.0, 1)) {
+    for (Object& o : from.objects) {
+      for (Vec3& p : o.positions) p += Vec3(offset, 0, 0);
+      triangles += static_cast<std::size_t>(o.num_triangles());
+    }
+    from.index = 0;
+    to = moved(from, 5, 0.6, 0.1);
+  }
+};
+
+TEST(CcdStage2, DefaultCellAllowsForAMarginLargerThanTheTriangles) {
+  const OffsetStep step(std::ldexp(1.0, 33));
+  const Frame& from = step.from;
+  const Frame& to = step.to;
+  const std::size_t triangles = step.triangles;
+  const CcdSweep sweep = CcdSweep::compute(from, to, 2);
   ASSERT_GT(sweep.margin, 0.5) << sweep.margin;  // larger than the scene's triangles (edges ~0.3-0.5)
   const CcdVoxelCulling voxels(from, to, sweep, 0, 2);
   const std::size_t records = triangles * static_cast<std::size_t>(voxels.slots());
@@ -211,14 +222,11 @@ TEST(CcdStage2, DefaultCellAllowsForAMarginLargerThanTheTriangles) {
 // grid made every record cover ~N^3 voxels: --grid 128 took over 60 s and 19 GB on a small
 // scene at 1e12, 200 ran out of memory.
 TEST(CcdStage2, GivenGridIsCoarsenedWhereTheMarginDwarfsTheTriangles) {
-  Frame from = test::make_random_frame(3, 3, 2.0, 1);
-  for (Object& o : from.objects)
-    for (Vec3& p : o.positions) p += Vec3(std::ldexp(1.0, 33), 0, 0);
-  from.index = 0;
-  const Frame to = moved(from, 5, 0.6, 0.1);
+  const OffsetStep step(std::ldexp(1.0, 33));
+  const Frame& from = step.from;
+  const Frame& to = step.to;
+  const std::size_t triangles = step.triangles;
   const CcdSweep sweep = CcdSweep::compute(from, to, 2);
-  std::size_t triangles = 0;
-  for (const Object& o : from.objects) triangles += static_cast<std::size_t>(o.num_triangles());
   const CcdStepResult ref = continuous_collisions_brute_force(from, to);
   for (int grid : {16, 200, 4096}) {
     SCOPED_TRACE("grid " + std::to_string(grid));
@@ -228,10 +236,8 @@ TEST(CcdStage2, GivenGridIsCoarsenedWhereTheMarginDwarfsTheTriangles) {
     test::expect_same_ccd(continuous_collisions(from, to, sweep, CcdOptions{2, &voxels}), ref);
   }
   // Near the origin a grid of 16 is what it says: the bound does not bite.
-  Frame near = test::make_random_frame(3, 3, 2.0, 1);
-  near.index = 0;
-  const Frame near_to = moved(near, 5, 0.6, 0.1);
-  const CcdVoxelCulling given(near, near_to, CcdSweep::compute(near, near_to, 2), 16, 2);
+  const OffsetStep near(0);
+  const CcdVoxelCulling given(near.from, near.to, CcdSweep::compute(near.from, near.to, 2), 16, 2);
   EXPECT_EQ(std::max({given.grid().dims[0], given.grid().dims[1], given.grid().dims[2]}), 17);
 }
 

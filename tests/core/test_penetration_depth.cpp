@@ -711,6 +711,19 @@ TEST(PenetrationDepthSelf, DentPushedThroughTheBottomIsAnInwardFold) {
   }
 }
 
+/// PD of boxes a and b as two objects (the twin) and as one object of two components (self),
+/// both asserted to be one entry with status Ok.
+std::pair<PenetrationDepth, PenetrationDepth> twin_and_self(const Object& a, const Object& b) {
+  const auto twin = run_pd(frame_of({a, b}));
+  const auto self = run_pd(frame_of({merge({a, b}, "ab")}));
+  EXPECT_EQ(twin.size(), 1u);
+  EXPECT_EQ(self.size(), 1u);
+  if (twin.size() != 1 || self.size() != 1) return {};
+  EXPECT_EQ(twin[0].status, PdStatus::Ok);
+  EXPECT_EQ(self[0].status, PdStatus::Ok) << pd_status_name(self[0].status);
+  return {twin[0], self[0]};
+}
+
 TEST(PenetrationDepthSelf, CoarseMergedBoxesMatchTheTwin) {
   // 12-triangle boxes offset along all axes, as one object of two components: every
   // triangle near the contact intersects, each side has a single inside corner. The self
@@ -719,15 +732,10 @@ TEST(PenetrationDepthSelf, CoarseMergedBoxesMatchTheTwin) {
   for (const Vec3& offset : {Vec3(0.5, 0.2, 0.3), Vec3(-0.3, 0.6, -0.45), Vec3(0.7, -0.1, 0.25)}) {
     const Object a = make_box(Vec3::Zero(), Vec3::Ones(), 1, "a");
     const Object b = make_box(offset, Vec3::Ones(), 1, "b");
-    const auto twin = run_pd(frame_of({a, b}));
-    const auto self = run_pd(frame_of({merge({a, b}, "ab")}));
-    ASSERT_EQ(twin.size(), 1u);
-    ASSERT_EQ(self.size(), 1u);
-    ASSERT_EQ(twin[0].status, PdStatus::Ok);
-    ASSERT_EQ(self[0].status, PdStatus::Ok) << pd_status_name(self[0].status);
-    EXPECT_GT(self[0].depth, 0.0);
-    EXPECT_LE(std::abs(self[0].depth - twin[0].depth), 1e-12) << self[0].depth << " vs " << twin[0].depth;
-    EXPECT_LE(std::abs(std::abs(self[0].direction.dot(twin[0].direction)) - 1), 1e-12);
+    const auto [twin, self] = twin_and_self(a, b);
+    EXPECT_GT(self.depth, 0.0);
+    EXPECT_LE(std::abs(self.depth - twin.depth), 1e-12) << self.depth << " vs " << twin.depth;
+    EXPECT_LE(std::abs(std::abs(self.direction.dot(twin.direction)) - 1), 1e-12);
   }
 }
 
@@ -740,15 +748,10 @@ TEST(PenetrationDepthSelf, SheetRunningOnAcrossAnEdgeIsNotTheTarget) {
   // (depth 2.83 along a diagonal), instead of b's bottom, 0.75 below (the twin's answer).
   const Object a = make_box(Vec3(0.25, 0.375, -2.5), Vec3::Constant(2), 2, "a");
   const Object b = make_box(Vec3(0.25, -0.875, -2.5), Vec3::Constant(2), 1, "b");
-  const auto twin = run_pd(frame_of({a, b}));
-  const auto self = run_pd(frame_of({merge({a, b}, "ab")}));
-  ASSERT_EQ(twin.size(), 1u);
-  ASSERT_EQ(self.size(), 1u);
-  ASSERT_EQ(twin[0].status, PdStatus::Ok);
-  ASSERT_EQ(self[0].status, PdStatus::Ok) << pd_status_name(self[0].status);
-  EXPECT_EQ(twin[0].depth, 0.75);
-  EXPECT_EQ(self[0].depth, 0.75);
-  EXPECT_LE(std::abs(std::abs(self[0].direction.y()) - 1), 1e-12) << self[0].direction.transpose();
+  const auto [twin, self] = twin_and_self(a, b);
+  EXPECT_EQ(twin.depth, 0.75);
+  EXPECT_EQ(self.depth, 0.75);
+  EXPECT_LE(std::abs(std::abs(self.direction.y()) - 1), 1e-12) << self.direction.transpose();
 }
 
 TEST(PenetrationDepthSelf, UndefinedCasesGetAStatus) {
