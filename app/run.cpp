@@ -118,9 +118,14 @@ VoronoiStage make_voronoi_stage(const Config& config, int threads) {
     }
   }
   if (stage.context) {
-    stage.backend = std::make_unique<gl::GlVoronoiBackend>(*stage.context);
-    stage.self_backend = std::make_unique<gl::GlSelfVoronoiBackend>(*stage.context);
-    stage.ccd_backend = std::make_unique<gl::GlCcdVoxelBackend>(*stage.context);
+    // The CPU twin that redoes what a shader could not finish runs on --threads too.
+    gl::GlVoronoiOptions gl_options;
+    gl_options.cpu_threads = threads;
+    gl::GlCcdVoxelOptions ccd_options;
+    ccd_options.cpu_threads = threads;
+    stage.backend = std::make_unique<gl::GlVoronoiBackend>(*stage.context, gl_options);
+    stage.self_backend = std::make_unique<gl::GlSelfVoronoiBackend>(*stage.context, gl_options);
+    stage.ccd_backend = std::make_unique<gl::GlCcdVoxelBackend>(*stage.context, ccd_options);
   } else {
     stage.backend = make_cpu_voronoi_backend(threads);
     stage.self_backend = make_cpu_self_voronoi_backend(threads);

@@ -120,7 +120,7 @@ CcdVoxelOutput GlCcdVoxelBackend::voxelize(const CcdVoxelInput& in) {
       std::any_of(out.foreign.begin(), out.foreign.end(), [](std::uint32_t f) { return f == 2; });
   last_fell_back_ = incomplete;
   if (incomplete) {
-    CcdVoxelOutput cpu = make_cpu_ccd_voxel_backend(0)->voxelize(in);
+    CcdVoxelOutput cpu = make_cpu_ccd_voxel_backend(options_.cpu_threads)->voxelize(in);
     cpu.upload_ms += out.upload_ms;
     cpu.compute_ms += out.compute_ms;
     cpu.readback_ms += out.readback_ms;

@@ -17,6 +17,8 @@ struct GlCcdVoxelOptions {
   /// Largest key buffer of one batch in bytes; 0: GL_MAX_SHADER_STORAGE_BLOCK_SIZE. Records
   /// are processed in batches whose key room fits (tests use small values to exercise it).
   std::size_t max_batch_bytes = 0;
+  /// Threads of the CPU twin that redoes a step the shader could not finish; 0: all cores.
+  int cpu_threads = 0;
 };
 
 /// Lifetime and threading as GlVoronoiBackend: `context` must outlive the backend, stay in

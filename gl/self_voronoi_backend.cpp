@@ -103,7 +103,7 @@ SelfDvdOutput GlSelfVoronoiBackend::compute(const SelfDvdInput& self) {
     part.dvd = with_samples(in, redo);
     part.tri_vertices = self.tri_vertices;
     for (const std::size_t k : redo) part.sample_triangle.push_back(self.sample_triangle[k]);
-    const SelfDvdOutput cpu = make_cpu_self_voronoi_backend(resolve_threads(0))->compute(part);
+    const SelfDvdOutput cpu = make_cpu_self_voronoi_backend(resolve_threads(options_.cpu_threads))->compute(part);
     for (std::size_t j = 0; j < redo.size(); ++j) {
       out.dist[redo[j]] = cpu.dist[j];
       last_nearest_[redo[j]] = kNoIndex;

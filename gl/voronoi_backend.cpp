@@ -197,7 +197,7 @@ DvdOutput GlVoronoiBackend::compute(const DvdInput& in) {
     if (out.site1[k] == kShaderIncomplete) redo.push_back(k);
   last_redone_ = redo.size();
   if (!redo.empty()) {
-    const DvdOutput cpu = make_cpu_voronoi_backend(resolve_threads(0))->compute(with_samples(in, redo));
+    const DvdOutput cpu = make_cpu_voronoi_backend(resolve_threads(options_.cpu_threads))->compute(with_samples(in, redo));
     for (std::size_t j = 0; j < redo.size(); ++j) {
       out.site1[redo[j]] = cpu.site1[j];
       out.site2[redo[j]] = cpu.site2[j];

@@ -17,6 +17,9 @@ struct GlVoronoiOptions {
   /// in batches of local_size * this (fewer when the per-batch buffers would exceed
   /// GL_MAX_SHADER_STORAGE_BLOCK_SIZE). Tests use small values to exercise batching.
   GLuint max_groups_per_dispatch = 0;
+  /// Threads of the CPU twin that computes the samples the shader could not finish (a
+  /// driver's loop cap); 0: all cores.
+  int cpu_threads = 0;
 };
 
 /// The GL compute backend ("gpu").
