@@ -60,6 +60,9 @@ std::unique_ptr<SelfVoronoiBackend> make_cpu_self_voronoi_backend(int threads);
 /// sample, 3 vertex ids per triangle. Throws std::invalid_argument naming the problem.
 void validate_self_dvd_input(const SelfDvdInput& in);
 
+/// Only triangles whose 2-ring bound exceeds this many δ are sampled (self_stage2.cpp).
+inline constexpr double kSelfSampleRing2OverDelta = 2.0;
+
 struct SelfVoronoiBounds {
   VoronoiGrid grid;
   double delta = 0;            ///< δ = (cell diagonal)/2 + voxelization slack + δ_precision

@@ -1,6 +1,7 @@
 // End-to-end: the CLI's distance.intra (JSON) and distance/intra (HDF5) equal the library's
 // brute force, with every Stage II backend.
 #include "core/query/intra_distance.hpp"
+#include "core/voronoi/self_stage2.hpp"
 #include "io/hdf5_reader.hpp"
 #include "io/scene_source.hpp"
 #include "support/cli.hpp"
@@ -62,7 +63,7 @@ TEST(CliIntra, JsonAndHdf5EqualBruteForceWithEveryBackend) {
     EXPECT_GT(j["frames"][0]["stats"]["intra_exact_tests"].get<std::uint64_t>(), 0u);
     EXPECT_EQ(j["frames"][0]["stats"].contains("self_voronoi"), std::string(backend) != "off");
     if (std::string(backend) != "off") {
-      // Sampled: the triangles of objects with pairs whose 2-ring bound exceeds δ and that
+      // Sampled: the triangles of objects with pairs whose 2-ring bound exceeds 2δ and that
       // have a non-adjacent triangle (not the tetrahedron's).
       const auto& sv = j["frames"][0]["stats"]["self_voronoi"];
       const double delta = sv["delta"].get<double>();
@@ -71,7 +72,7 @@ TEST(CliIntra, JsonAndHdf5EqualBruteForceWithEveryBackend) {
       for (size_t i = 0; i < ring2.size(); ++i)
         if (ring2[i].size() >= 2)
           for (size_t t = 0; t < ring2[i].size(); ++t)
-            want += ring2[i][t] > delta && test::has_non_adjacent(frame.objects[i], static_cast<Index>(t));
+            want += ring2[i][t] > kSelfSampleRing2OverDelta * delta && test::has_non_adjacent(frame.objects[i], static_cast<Index>(t));
       EXPECT_EQ(sv["sampled_triangles"].get<std::uint64_t>(), want);
       EXPECT_FALSE(j["frames"][0]["stats"]["voronoi"].contains("sampled_triangles"));
     }

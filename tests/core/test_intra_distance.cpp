@@ -267,10 +267,6 @@ void for_each_recorded_run(const Check& check) {
   }
 }
 
-// Only triangles whose 2-ring bound exceeds δ get samples (Stage II cannot lower the others'
-// D_u), and that have a non-adjacent triangle at all (not a tetrahedron's faces); the others
-// keep D_u = 2-ring bound and D_l = -inf. Both kinds occur, and Stage II still culls
-// candidates on these scenes.
 // The default self grid: sqrt(n) cells for one surface spanning the scene, but no cell below
 // 0.7 of the median triangle, so a crowd of small objects is not sampled at cells far below its
 // triangles (27.7 samples per triangle for 2,000 blobs before); clamped to [32, 512].
@@ -299,7 +295,11 @@ TEST(IntraStage2, DefaultGridFollowsTheMedianTriangleInCrowds) {
   expect_same_intra(intra_object_distance(frame, boxes, ring2, IntraDistanceOptions{2, &vb}), ref, "crowd, default grid");
 }
 
-TEST(IntraStage2, OnlyTrianglesWhoseRing2BoundExceedsDeltaAreSampled) {
+// Only triangles whose 2-ring bound exceeds 2δ get samples (kSelfSampleRing2OverDelta: below
+// δ Stage II cannot lower their D_u, and up to 2δ it rarely gains anything), and that have a
+// non-adjacent triangle at all (not a tetrahedron's faces); the others keep D_u = 2-ring bound
+// and D_l = -inf. Both kinds occur, and Stage II still culls candidates on these scenes.
+TEST(IntraStage2, OnlyTrianglesWhoseRing2BoundExceedsTwiceDeltaAreSampled) {
   std::uint64_t sampled = 0, unsampled = 0, culled = 0;
   for_each_recorded_run([&](const Frame& frame, const FrameBoxes& boxes, const std::vector<std::vector<double>>& ring2,
                             const SelfVoronoiBounds& vb, const Recorder& rec) {
@@ -313,7 +313,7 @@ TEST(IntraStage2, OnlyTrianglesWhoseRing2BoundExceedsDeltaAreSampled) {
       const size_t n = ring2[i].size();
       const bool has_pairs = n >= 2;
       for (size_t t = 0; t < n; ++t) {
-        const bool want = has_pairs && ring2[i][t] > vb.delta &&
+        const bool want = has_pairs && ring2[i][t] > kSelfSampleRing2OverDelta * vb.delta &&
                           test::has_non_adjacent(frame.objects[i], static_cast<Index>(t));
         const bool got = has_pairs && has_samples[global + t] != 0;
         ASSERT_EQ(got, want) << "object " << i << " triangle " << t;
