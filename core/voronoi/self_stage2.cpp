@@ -141,12 +141,12 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
   // frames 10-13 the Stage II culls went 17 -> 17 (skirt), 26 -> 26 (bowl), 11 -> 0 (funnel)
   // and 2 -> 0 (cloth-ball) while the samples went down by up to 68%. Between δ and 2δ, D_u
   // can gain only where SD~ < δ, and D_l stays below 2δ, which culls about as little: frames
-  // 10-13 again, 2δ instead of δ: culls 1 -> 1 (skirt), 26 -> 20 (bowl), 0 -> 0 (cloth-ball, funnel,
-  // breaking), intra-object exact tests within 1% (breaking +0.9%), samples 299K -> 58K
-  // (skirt), 362K -> 118K (cloth-ball), 188K -> 46K (breaking); on the 200-object scene
-  // 214K -> 1.4K and self Stage II 121 -> 10 ms per frame, 0 culls either way. Nor are triangles that share
-  // a vertex with every other triangle of their object (may_have_candidate()): they have no
-  // answer and are no other triangle's candidate. An unsampled triangle keeps D_u = 2-ring
+  // 10-13 again, 2δ instead of δ: culls 1 -> 1 (skirt), 26 -> 20 (bowl), 0 -> 0 (cloth-ball,
+  // funnel, breaking), intra-object exact tests within 1% (breaking +0.9%), samples 299K ->
+  // 58K (skirt), 362K -> 118K (cloth-ball), 188K -> 46K (breaking); on the 200-object scene
+  // 214K -> 1.4K and self Stage II 121 -> 10 ms per frame, 0 culls either way. Nor are
+  // triangles that share a vertex with every other triangle of their object
+  // (may_have_candidate()): they have no answer and are no other triangle's candidate. An unsampled triangle keeps D_u = 2-ring
   // bound and D_l = -inf: less culling, never a different answer.
   std::vector<std::vector<Sample>> hits(n);
   std::vector<std::uint64_t> sampled(n, 0);
@@ -164,16 +164,14 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
     }
   });
   std::vector<Sample> samples;
-  std::uint64_t max_voxel = 0;
   for (size_t i = 0; i < n; ++i) {
     samples.insert(samples.end(), hits[i].begin(), hits[i].end());
     out.sampled_triangles += sampled[i];
-    for (const Sample& s : hits[i]) max_voxel = std::max(max_voxel, static_cast<std::uint64_t>(s.voxel));
   }
   hits.clear();
   // Samples are in triangle order (objects in order, each object's triangles ascending): a
   // stable sort by voxel orders them by (voxel, triangle).
-  stable_radix_sort(samples, max_voxel, [](const Sample& s) { return static_cast<std::uint64_t>(s.voxel); });
+  stable_radix_sort(samples, [](const Sample& s) { return static_cast<std::uint64_t>(s.voxel); });
 
   // Bands: f needs exact values up to its 2-ring bound + δ (+ slack): below that a value can
   // improve D_u(f), and a capped value then gives D_l(f) = band - δ >= the 2-ring bound, which

@@ -92,13 +92,10 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   if (hit_base[n] >= (std::uint64_t{1} << 32))
     throw std::length_error("Stage II: more than 2^32 voxel marks; use a coarser --grid");
   vb.reserve(hit_base[n]);
-  std::uint64_t max_voxel = 0;
   for (size_t i = 0; i < n; ++i)
-    for (size_t j = 0; j < hits[i].size(); ++j) {
+    for (size_t j = 0; j < hits[i].size(); ++j)
       vb.push_back({hits[i][j].voxel, obj_band[i], static_cast<std::int32_t>(i), static_cast<std::uint32_t>(hit_base[i] + j)});
-      max_voxel = std::max(max_voxel, static_cast<std::uint64_t>(hits[i][j].voxel));
-    }
-  stable_radix_sort(vb, max_voxel, [](const VoxelBand& x) { return static_cast<std::uint64_t>(x.voxel); });
+  stable_radix_sort(vb, [](const VoxelBand& x) { return static_cast<std::uint64_t>(x.voxel); });
   // The sample each hit was merged into, for the scan.
   std::vector<std::uint32_t> hit_sample(hit_base[n]);
   for (size_t k = 0; k < vb.size();) {
