@@ -152,7 +152,7 @@ std::vector<MeshGroup> read_with_assimp(const fs::path& file) {
   for (std::size_t k = 0; k < groups.size(); ++k) {
     if (groups[k].name.empty()) {
       groups[k].name = groups.size() == 1 ? stem : stem + "_" + std::to_string(k);
-      if (unnamed == 1) groups[k].unnamed = 0;
+      groups[k].file_named = unnamed == 1;
     }
   }
   return groups;

@@ -107,7 +107,7 @@ std::vector<MeshGroup> split_components(const MeshGroup& group) {
   for (std::size_t c = 0; c < parts.size(); ++c) {
     parts[c].name = group.name + "#" + std::to_string(c);
     parts[c].origin.mesh = group.name;
-    parts[c].origin.unnamed_mesh = group.unnamed;
+    parts[c].origin.file_named = group.file_named;
   }
   // Vertices in global order; a vertex belongs to its root's component if that has faces.
   std::vector<Index> local(nv, kNoIndex);

@@ -15,9 +15,9 @@ struct MeshGroup {
   std::string name;
   std::vector<Vec3> positions;
   std::vector<Face> faces;
-  /// 0 when this is the only mesh of its file that the file gives no name of its own (`name` is
-  /// then made from the file's name), else -1. See ComponentOrigin.
-  int unnamed = -1;
+  /// Whether this is the only mesh of its file that the file gives no name of its own (`name`
+  /// is then made from the file's name). See ComponentOrigin.
+  bool file_named = false;
   /// Set by split_components(): the mesh this component was cut from (core/mesh/topology.hpp).
   ComponentOrigin origin;
 };

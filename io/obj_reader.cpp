@@ -78,7 +78,7 @@ class ObjParser {
       MeshGroup one;
       const bool named = with_faces.size() == 1 && !with_faces[0]->name.empty() && mode == ObjGroups::Split;
       one.name = named ? with_faces[0]->name : stem;
-      if (!named) one.unnamed = 0;
+      one.file_named = !named;
       one.positions = std::move(positions_);
       // Groups follow each other in the file, so concatenating them keeps file order.
       std::size_t n = 0;
@@ -106,7 +106,7 @@ class ObjParser {
       used.erase(std::unique(used.begin(), used.end()), used.end());
       MeshGroup mg;
       mg.name = g.name.empty() ? stem + "_" + std::to_string(k) : g.name;
-      if (g.name.empty() && unnamed == 1) mg.unnamed = 0;
+      mg.file_named = g.name.empty() && unnamed == 1;
       mg.positions.reserve(used.size());
       for (std::size_t i = 0; i < used.size(); ++i) {
         local[static_cast<std::size_t>(used[i])] = static_cast<Index>(i);

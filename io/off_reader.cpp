@@ -98,7 +98,7 @@ class OffParser {
     check_counts_fit();
     MeshGroup out;
     out.name = file_.stem().string();
-    out.unnamed = 0;
+    out.file_named = true;
     out.positions.reserve(static_cast<std::size_t>(num_vertices_));
     out.faces.reserve(static_cast<std::size_t>(num_faces_));
     std::string_view line;

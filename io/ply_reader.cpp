@@ -508,7 +508,7 @@ MeshGroup read_ply(const fs::path& file) {
 
   MeshGroup out;
   out.name = file.stem().string();
-  out.unnamed = 0;
+  out.file_named = true;
   Where where;
   where.file = &file;
   if (h.format == Format::Ascii) {

@@ -37,28 +37,27 @@ class AdjacencyCache {
 /// A mesh the file gives no name of its own (a PLY or OFF file, an OBJ without groups, an
 /// unnamed OBJ group, an unnamed assimp mesh) is named after the file, and the file name
 /// changes from frame to frame: when it is the file's only unnamed mesh, it is identified as
-/// that (`unnamed_mesh` 0) instead of by its name. (Of several unnamed meshes in one file,
+/// that (`file_named`) instead of by its name. (Of several unnamed meshes in one file,
 /// none is: pairing them by position would read a mesh that vanished and its neighbour as
 /// one moving mesh.) Meshes of the scene's static files are also told apart by the file
 /// (`static_file`).
 struct ComponentOrigin {
-  std::string mesh;       ///< the mesh's name (for messages; identifies it when unnamed_mesh < 0)
-  int unnamed_mesh = -1;  ///< 0 for the only mesh its file does not name, else -1
+  std::string mesh;         ///< the mesh's name (for messages; identifies it unless file_named)
+  bool file_named = false;  ///< the only mesh its file does not name (named after the file)
   int static_file = -1;   ///< for static geometry, the position of its file in "static"
   std::vector<Index> vertices;
   bool empty() const { return vertices.empty(); }
-  /// Whether both come from the same mesh: the same static file (or none), then the same
-  /// position among the unnamed meshes when the file names neither, else the same name.
+  /// Whether both come from the same mesh: the same static file (or none), then both their
+  /// file's only unnamed mesh, or else the same name.
   bool same_mesh(const ComponentOrigin& o) const {
-    if (static_file != o.static_file) return false;
-    if (unnamed_mesh >= 0 || o.unnamed_mesh >= 0) return unnamed_mesh == o.unnamed_mesh;
-    return mesh == o.mesh;
+    if (static_file != o.static_file || file_named != o.file_named) return false;
+    return file_named || mesh == o.mesh;
   }
   /// Orders origins by mesh (as same_mesh() identifies it), then vertices.
   bool operator<(const ComponentOrigin& o) const {
     if (static_file != o.static_file) return static_file < o.static_file;
-    if (unnamed_mesh != o.unnamed_mesh) return unnamed_mesh < o.unnamed_mesh;
-    if (unnamed_mesh < 0 && mesh != o.mesh) return mesh < o.mesh;
+    if (file_named != o.file_named) return file_named < o.file_named;
+    if (!file_named && mesh != o.mesh) return mesh < o.mesh;
     return vertices < o.vertices;
   }
   bool operator==(const ComponentOrigin& o) const { return vertices == o.vertices && same_mesh(o); }
