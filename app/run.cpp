@@ -258,6 +258,7 @@ void run(const Config& config) {
         result.time_ms.voronoi = sw.elapsed_ms();
         opts.voronoi = &bounds;
         result.voronoi = frame_stats(bounds, bounds.sample_voxels);
+        result.voronoi->sampled_triangles = bounds.sampled_triangles;
       }
       if (want_distance) {
         InterDistanceOutput d = inter_object_distance(frame, boxes, stage1, opts);

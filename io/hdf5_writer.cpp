@@ -618,6 +618,7 @@ struct Hdf5ResultWriter::Impl {
       write_attribute(s, stats_where, "voronoi_delta", v.delta);
       write_attribute(s, stats_where, "voronoi_delta_precision", v.delta_precision);
       write_attribute(s, stats_where, "voronoi_sample_voxels", std::uint64_t{v.sample_voxels});
+      write_attribute(s, stats_where, "voronoi_sampled_triangles", v.sampled_triangles.value_or(0));
       write_attribute(s, stats_where, "voronoi_time_ms_upload", v.upload_ms);
       write_attribute(s, stats_where, "voronoi_time_ms_compute", v.compute_ms);
       write_attribute(s, stats_where, "voronoi_time_ms_readback", v.readback_ms);

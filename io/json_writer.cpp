@@ -231,6 +231,7 @@ Json frame_json(const FrameResult& frame, double write_ms) {
     vj["delta"] = v.delta;
     vj["delta_precision"] = v.delta_precision;
     vj["sample_voxels"] = v.sample_voxels;
+    if (v.sampled_triangles) vj["sampled_triangles"] = *v.sampled_triangles;
     vj["time_ms"] = {{"setup", v.setup_ms}, {"upload", v.upload_ms}, {"compute", v.compute_ms},
                      {"readback", v.readback_ms}, {"scan", v.scan_ms}};
     stats["voronoi"] = std::move(vj);

@@ -62,21 +62,72 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   out.delta = sg.delta(out.delta_precision);
   const double slack = rounding_slack(boxes.magnitude);
 
-  // Conservative voxelization, per object in parallel, then merged in object order.
-  std::vector<std::vector<VoxelHit>> hits(n);
-  parallel_for(n, threads, [&](size_t i) {
-    const Object& o = frame.objects[i];
-    for (Index t = 0; t < o.num_triangles(); ++t)
-      sg.voxelize(o.triangle(t), boxes.triangles[i][static_cast<size_t>(t)],
-                  [&](std::int64_t id) { hits[i].push_back({id, static_cast<Index>(i), t}); });
-  });
-
   // Bands: object i needs exact values up to U_i + δ (+ slack) so that its capped triangles
   // are culled (D_l = band - δ > D_u); capped at kMaxBandCells cells.
+  std::vector<double> band_len(n);
+  for (size_t i = 0; i < n; ++i)
+    band_len[i] = std::min(stage1.upper_bound[i] + out.delta + slack, kMaxBandCells * grid.cell);
+
+  // A sample point farther than its band from every other object's box gets the band back:
+  // the backend's walk there finds nothing. So, per object, the objects whose boxes lie within
+  // its band of its box; a triangle whose box is farther than the band from all of them is not
+  // sampled and gets D_l = band (it is at least that far from every other object: more than
+  // the band - δ its samples could give), and a sampled triangle's voxels whose centres lie
+  // farther than the band from those boxes count as the band without being computed.
+  std::vector<std::vector<Index>> near(n);
+  {
+    const ObjectBoxTree& tree = boxes.object_tree();
+    parallel_for(n, threads, [&](size_t i) {
+      if (boxes.objects[i].empty()) return;
+      const double b = band_len[i];
+      tree.bvh.query(boxes.objects[i], [b] { return b; }, [&](Index t, double) {
+        const Index j = tree.ids[static_cast<size_t>(t)];
+        if (j != static_cast<Index>(i)) near[i].push_back(j);
+      });
+    });
+  }
+
+  // Conservative voxelization, per object in parallel, then merged in object order.
+  std::vector<std::vector<VoxelHit>> hits(n);
+  // Per object, the sampled triangles some of whose voxels were left out.
+  std::vector<std::vector<std::uint8_t>> capped(n);
+  std::vector<std::uint64_t> sampled(n, 0);
+  parallel_for(n, threads, [&](size_t i) {
+    const Object& o = frame.objects[i];
+    const double b2 = band_len[i] * band_len[i];
+    auto& lower = out.triangle_lower[i];
+    capped[i].assign(lower.size(), 0);
+    std::vector<const AABB*> close;
+    const double b = band_len[i];
+    for (Index t = 0; t < o.num_triangles(); ++t) {
+      const AABB& bt = boxes.triangles[i][static_cast<size_t>(t)];
+      close.clear();
+      for (Index j : near[i]) {
+        const auto uj = static_cast<size_t>(j);
+        if (box_distance_squared(bt, boxes.objects[uj]) > b2) continue;
+        boxes.bvh(uj).query(bt, [b] { return b; }, [&](Index g, double) { close.push_back(&boxes.triangles[uj][static_cast<size_t>(g)]); });
+      }
+      if (close.empty()) {
+        lower[static_cast<size_t>(t)] = band_len[i];
+        continue;
+      }
+      ++sampled[i];
+      sg.voxelize(o.triangle(t), bt, [&](std::int64_t id) {
+        const Vec3 c = grid.center(id);
+        for (const AABB* bj : close)
+          if ((bj->lo - c).cwiseMax(c - bj->hi).cwiseMax(0.0).squaredNorm() <= b2) {
+            hits[i].push_back({id, static_cast<Index>(i), t});
+            return;
+          }
+        capped[i][static_cast<size_t>(t)] = 1;
+      });
+    }
+  });
+  for (size_t i = 0; i < n; ++i) out.sampled_triangles += sampled[i];
+
   // Each band is passed to the backend as a float in its units, rounded up.
   std::vector<float> obj_band(n, 0.0f);
-  for (size_t i = 0; i < n; ++i)
-    obj_band[i] = sg.backend_band(std::min(stage1.upper_bound[i] + out.delta + slack, kMaxBandCells * grid.cell));
+  for (size_t i = 0; i < n; ++i) obj_band[i] = sg.backend_band(band_len[i]);
 
   DvdInput in;
   in.grid = sg.backend_grid();
@@ -146,9 +197,13 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
       st = std::min(st, for_lower);
       if (site != kNoIndex && v < band) sd_obj_usable = std::min(sd_obj_usable, v);
     }
-    // Every triangle marks at least one voxel; should one not, it stays uncullable.
-    for (size_t t = 0; t < lower.size(); ++t)
+    for (size_t t = 0; t < lower.size(); ++t) {
+      if (lower[t] != -kInfinity) continue;  // not sampled: D_l is its band already
+      // A voxel left out lies farther than the band from every other object.
+      if (capped[i][t]) sd_tri[t] = std::min(sd_tri[t], band_len[i]);
+      // Every sampled triangle marks at least one voxel; should one not, it stays uncullable.
       lower[t] = sd_tri[t] == kInfinity ? -kInfinity : sd_tri[t] - out.delta;
+    }
     out.object_upper[i] = std::min(stage1.upper_bound[i], sd_obj_usable + out.delta);
   });
   out.scan_ms = sw.elapsed_ms();

@@ -24,6 +24,9 @@ struct VoronoiBounds {
   /// D_l(f) = SD~(f) - δ per triangle: f is at least this far from every other object.
   std::vector<std::vector<double>> triangle_lower;
   std::uint64_t sample_voxels = 0;
+  /// Triangles with samples: those whose box lies within their object's band of another
+  /// object's box (the others get D_l = band without a sample).
+  std::uint64_t sampled_triangles = 0;
   double setup_ms = 0, upload_ms = 0, compute_ms = 0, readback_ms = 0, scan_ms = 0;
 };
 

@@ -10,6 +10,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <string>
 
 namespace vproxq {
 namespace {
@@ -45,6 +47,115 @@ TEST(Stage2, BoundsHoldAndResultsEqualBruteForce) {
         EXPECT_EQ(got.per_object[i].distance, ref.per_object[i].distance);
         EXPECT_EQ(got.per_object[i].triangles, ref.per_object[i].triangles);
         EXPECT_EQ(got.per_object[i].points[0], ref.per_object[i].points[0]);
+      }
+    }
+  }
+}
+
+/// Exact distance from triangle t of object i to every other object of the frame.
+double exact_triangle_separation(const Frame& frame, size_t i, Index t) {
+  double sd = kInfinity;
+  for (size_t j = 0; j < frame.objects.size(); ++j) {
+    if (j == i) continue;
+    for (Index u = 0; u < frame.objects[j].num_triangles(); ++u)
+      sd = std::min(sd, triangle_distance(frame.objects[i].triangle(t), frame.objects[j].triangle(u)).distance);
+  }
+  return sd;
+}
+
+/// A flat sheet of 2 * n * n triangles over [0, size]^2 at z = 0.
+Object make_sheet(int n, double size, const std::string& name) {
+  auto topo = std::make_shared<Topology>();
+  Object o;
+  o.name = name;
+  for (int y = 0; y <= n; ++y)
+    for (int x = 0; x <= n; ++x) o.positions.emplace_back(size * x / n, size * y / n, 0.0);
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const Index a = y * (n + 1) + x, b = a + 1, c = a + n + 1, d = c + 1;
+      topo->faces.push_back({a, b, d});
+      topo->faces.push_back({a, d, c});
+    }
+  topo->num_vertices = static_cast<Index>(o.positions.size());
+  o.topology = topo;
+  return o;
+}
+
+// Stage II samples only where another object may lie within the band: a triangle whose box is
+// farther than its object's band from every other object's box is not sampled and gets
+// D_l = band (its samples could give at most band - δ), and of the others only the voxels
+// within the band of some other object's triangle box are. Here a small blob sits over one
+// corner of a large sheet: the sheet's far triangles are not sampled.
+TEST(Stage2, OnlyTrianglesNearAnotherObjectAreSampled) {
+  test::Rng rng(5);
+  Frame frame;
+  frame.objects.push_back(make_sheet(24, 10.0, "sheet"));
+  frame.objects.push_back(test::make_blob(rng, Vec3(1.0, 1.0, 0.35), 0.25, 1, 0.1, "blob"));
+  const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
+  const ObjectBroadPhase stage1 = object_broad_phase(frame, boxes, 2);
+  auto backend = make_cpu_voronoi_backend(2);
+  const auto ref = inter_object_distance_brute_force(frame);
+  for (int grid : {16, 64, 200}) {
+    SCOPED_TRACE("grid " + std::to_string(grid));
+    const VoronoiBounds vb = compute_voronoi_bounds(frame, boxes, stage1, *backend, grid, 2);
+    const double cell = vb.grid.cell;
+    // The sample voxels lie within the band (<= 3 cells) of the blob's box, plus the sheet's
+    // triangles' voxels around it: at most this many.
+    const Vec3 reach = boxes.objects[1].hi - boxes.objects[1].lo + Vec3::Constant(2 * 4 * cell);
+    const double near_voxels = (reach / cell + Vec3::Ones()).prod();
+    EXPECT_LE(static_cast<double>(vb.sample_voxels), near_voxels);
+    EXPECT_LT(vb.sampled_triangles, static_cast<std::uint64_t>(frame.objects[0].num_triangles() / 4));
+    const double band0 = std::min(stage1.upper_bound[0] + vb.delta, 3 * cell);
+    Index far = 0;
+    for (size_t i = 0; i < 2; ++i) {
+      EXPECT_GE(vb.object_upper[i], ref.per_object[i].distance);
+      for (Index t = 0; t < frame.objects[i].num_triangles(); ++t) {
+        const double lower = vb.triangle_lower[i][static_cast<size_t>(t)];
+        ASSERT_LE(lower, exact_triangle_separation(frame, i, t)) << "object " << i << " triangle " << t;
+        if (i == 0 && std::sqrt(box_distance_squared(boxes.triangles[0][static_cast<size_t>(t)], boxes.objects[1])) > 3 * cell) {
+          ++far;
+          ASSERT_GE(lower, band0) << "triangle " << t;
+        }
+      }
+    }
+    EXPECT_GT(far, frame.objects[0].num_triangles() / 2);
+    InterDistanceOptions opts{2, &vb};
+    const auto got = inter_object_distance(frame, boxes, stage1, opts);
+    for (size_t i = 0; i < 2; ++i) {
+      EXPECT_EQ(got.per_object[i].distance, ref.per_object[i].distance);
+      EXPECT_EQ(got.per_object[i].triangles, ref.per_object[i].triangles);
+    }
+  }
+}
+
+// The same bounds on crowds where most triangles have another object within the band: blobs,
+// and soups of slivers and large triangles between them, at coarse to fine grids.
+TEST(Stage2, LowerBoundsHoldWhereOnlyPartOfTheVoxelsAreSampled) {
+  auto backend = make_cpu_voronoi_backend(2);
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    test::Rng rng(seed * 7919);
+    Frame frame = test::make_random_frame(seed, 5, 2.0, 1);
+    for (int k = 0; k < 3; ++k)
+      frame.objects.push_back(test::make_soup(rng, Vec3(1.0, 1.0, 1.0), 1.2, k == 0 ? 0.05 : 0.6, 30,
+                                              "soup" + std::to_string(k)));
+    const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
+    const ObjectBroadPhase stage1 = object_broad_phase(frame, boxes, 2);
+    const auto ref = inter_object_distance_brute_force(frame);
+    for (int grid : {6, 20, 48, 96}) {
+      SCOPED_TRACE("seed " + std::to_string(seed) + " grid " + std::to_string(grid));
+      const VoronoiBounds vb = compute_voronoi_bounds(frame, boxes, stage1, *backend, grid, 2);
+      for (size_t i = 0; i < frame.objects.size(); ++i) {
+        EXPECT_GE(vb.object_upper[i], ref.per_object[i].distance) << "object " << i;
+        for (Index t = 0; t < frame.objects[i].num_triangles(); ++t)
+          ASSERT_LE(vb.triangle_lower[i][static_cast<size_t>(t)], exact_triangle_separation(frame, i, t))
+              << "object " << i << " triangle " << t;
+      }
+      InterDistanceOptions opts{2, &vb};
+      const auto got = inter_object_distance(frame, boxes, stage1, opts);
+      for (size_t i = 0; i < frame.objects.size(); ++i) {
+        EXPECT_EQ(got.per_object[i].nearest_object, ref.per_object[i].nearest_object);
+        EXPECT_EQ(got.per_object[i].distance, ref.per_object[i].distance);
+        EXPECT_EQ(got.per_object[i].triangles, ref.per_object[i].triangles);
       }
     }
   }
