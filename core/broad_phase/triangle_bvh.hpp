@@ -55,6 +55,28 @@ class TriangleBvh {
   template <typename Skip, typename Visit>
   void query_overlaps(const AABB& query, const Skip& skip, const Visit& visit) const;
 
+  /// Whether some triangle's box lies within `bound` of `query` (squared box distance at most
+  /// bound^2); stops at the first.
+  bool any_within(const AABB& query, double bound) const {
+    if (nodes_.empty()) return false;
+    const double b2 = bound * bound;
+    std::int32_t stack[64];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+      const Node& node = nodes_[static_cast<size_t>(stack[--top])];
+      if (box_distance_squared(query, node.box) > b2) continue;
+      if (node.count > 0) {
+        for (std::int32_t k = node.first; k < node.first + node.count; ++k)
+          if (box_distance_squared(query, leaf_boxes_[static_cast<size_t>(k)]) <= b2) return true;
+        continue;
+      }
+      stack[top++] = node.first + 1;
+      stack[top++] = node.first;
+    }
+    return false;
+  }
+
   class BestFirst;
 
  private:

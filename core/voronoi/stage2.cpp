@@ -68,12 +68,17 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   for (size_t i = 0; i < n; ++i)
     band_len[i] = std::min(stage1.upper_bound[i] + out.delta + slack, kMaxBandCells * grid.cell);
 
-  // A sample point farther than its band from every other object's box gets the band back:
-  // the backend's walk there finds nothing. So, per object, the objects whose boxes lie within
-  // its band of its box; a triangle whose box is farther than the band from all of them is not
-  // sampled and gets D_l = band (it is at least that far from every other object: more than
-  // the band - δ its samples could give), and a sampled triangle's voxels whose centres lie
-  // farther than the band from those boxes count as the band without being computed.
+  // A sample point farther than its band from every other object gets the band back: the
+  // backend's walk there finds nothing. So only where another object's triangle boxes come
+  // within the band is anything sampled. A triangle whose box is farther than the band from
+  // every other object's triangle boxes is not sampled and gets D_l = band (it is at least that
+  // far from every other object: more than the band - δ its samples could give). Of a sampled
+  // triangle's voxels, those whose centres lie farther than the band from every other object's
+  // triangle boxes count as the band without being computed: Lemma 2 still holds, since the
+  // point p of the triangle nearest to another object lies in a voxel whose centre c is within
+  // sqrt(3) * half of it, and if that voxel counted as the band, every other triangle g has
+  // d(p, g) >= d(c, box(g)) - sqrt(3) * half > band - δ. `near`: per object, the objects whose
+  // boxes lie within its band of its box.
   std::vector<std::vector<Index>> near(n);
   {
     const ObjectBoxTree& tree = boxes.object_tree();
@@ -97,29 +102,29 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
     const double b2 = band_len[i] * band_len[i];
     auto& lower = out.triangle_lower[i];
     capped[i].assign(lower.size(), 0);
-    std::vector<const AABB*> close;
     const double b = band_len[i];
+    // Whether object j has a triangle box within the band of `box`.
+    auto within_band = [&](const AABB& box, size_t j) {
+      return box_distance_squared(box, boxes.objects[j]) <= b2 && boxes.bvh(j).any_within(box, b);
+    };
+    std::vector<size_t> close;  // the objects of near[i] within the band of triangle t
     for (Index t = 0; t < o.num_triangles(); ++t) {
       const AABB& bt = boxes.triangles[i][static_cast<size_t>(t)];
       close.clear();
-      for (Index j : near[i]) {
-        const auto uj = static_cast<size_t>(j);
-        if (box_distance_squared(bt, boxes.objects[uj]) > b2) continue;
-        boxes.bvh(uj).query(bt, [b] { return b; }, [&](Index g, double) { close.push_back(&boxes.triangles[uj][static_cast<size_t>(g)]); });
-      }
+      for (const Index j : near[i])
+        if (within_band(bt, static_cast<size_t>(j))) close.push_back(static_cast<size_t>(j));
       if (close.empty()) {
         lower[static_cast<size_t>(t)] = band_len[i];
         continue;
       }
       ++sampled[i];
       sg.voxelize(o.triangle(t), bt, [&](std::int64_t id) {
-        const Vec3 c = grid.center(id);
-        for (const AABB* bj : close)
-          if ((bj->lo - c).cwiseMax(c - bj->hi).cwiseMax(0.0).squaredNorm() <= b2) {
-            hits[i].push_back({id, static_cast<Index>(i), t});
-            return;
-          }
-        capped[i][static_cast<size_t>(t)] = 1;
+        AABB centre;
+        centre.lo = centre.hi = grid.center(id);
+        if (std::any_of(close.begin(), close.end(), [&](size_t j) { return within_band(centre, j); }))
+          hits[i].push_back({id, static_cast<Index>(i), t});
+        else
+          capped[i][static_cast<size_t>(t)] = 1;
       });
     }
   });

@@ -166,6 +166,34 @@ TEST(TriangleBvh, QueryOverlapsSkipsOnlyWhatNodeUnionsExclude) {
   EXPECT_GT(pruned_visits_saved, 0u);  // the pruning did prune
 }
 
+TEST(TriangleBvh, AnyWithinAgreesWithAScanOfTheBoxes) {
+  // Stage II's sampling filter: whether some triangle box lies within a bound of a query box
+  // (points and boxes, near and far, bounds from 0 up).
+  const Frame frame = make_random_frame(13, 2, 2.0, 2);
+  const FrameBoxes boxes = FrameBoxes::compute(frame, 1);
+  const auto& mine = boxes.triangles[0];
+  TriangleBvh bvh;
+  bvh.build(mine);
+  Rng rng(17);
+  int yes = 0, no = 0;
+  for (int q = 0; q < 3000; ++q) {
+    AABB query;
+    const AABB& around = boxes.objects[0];
+    Vec3 p;
+    for (int k = 0; k < 3; ++k) p[k] = rng.uniform(around.lo[k] - 0.5, around.hi[k] + 0.5);
+    query.extend(p);
+    if (q % 2) query.extend(p + Vec3(rng.uniform(0, 0.3), rng.uniform(0, 0.3), rng.uniform(0, 0.3)));
+    const double bound = q % 7 == 0 ? 0.0 : rng.uniform(0, 1.0);
+    bool want = false;
+    for (const AABB& b : mine) want = want || box_distance_squared(query, b) <= bound * bound;
+    ASSERT_EQ(bvh.any_within(query, bound), want) << "query " << q;
+    (want ? yes : no)++;
+  }
+  EXPECT_GT(yes, 300);
+  EXPECT_GT(no, 300);
+  EXPECT_FALSE(TriangleBvh().any_within(boxes.objects[0], 1e300));
+}
+
 TEST(TriangleBvhBestFirst, VisitsExactlyThePairsWithinTheBound) {
   // A random frame's objects as hierarchies, a few probes into each, and a fixed bound: the
   // search must visit every (probe, triangle) whose boxes are within the bound, once, and
