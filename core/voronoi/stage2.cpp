@@ -99,20 +99,22 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   std::vector<std::uint64_t> sampled(n, 0);
   parallel_for(n, threads, [&](size_t i) {
     const Object& o = frame.objects[i];
-    const double b2 = band_len[i] * band_len[i];
     auto& lower = out.triangle_lower[i];
     capped[i].assign(lower.size(), 0);
     const double b = band_len[i];
-    // Whether object j has a triangle box within the band of `box`.
-    auto within_band = [&](const AABB& box, size_t j) {
-      return box_distance_squared(box, boxes.objects[j]) <= b2 && boxes.bvh(j).any_within(box, b);
+    // Whether object j has a triangle box within `reach` of `box`.
+    auto within = [&](const AABB& box, size_t j, double reach) {
+      return box_distance_squared(box, boxes.objects[j]) <= reach * reach && boxes.bvh(j).any_within(box, reach);
     };
+    // Voxel centres are computed in scene coordinates, a few ulps of the largest one off:
+    // the rounding slack (~4.5e5 such ulps) keeps the test conservative.
+    const double centre_reach = b + slack;
     std::vector<size_t> close;  // the objects of near[i] within the band of triangle t
     for (Index t = 0; t < o.num_triangles(); ++t) {
       const AABB& bt = boxes.triangles[i][static_cast<size_t>(t)];
       close.clear();
       for (const Index j : near[i])
-        if (within_band(bt, static_cast<size_t>(j))) close.push_back(static_cast<size_t>(j));
+        if (within(bt, static_cast<size_t>(j), b)) close.push_back(static_cast<size_t>(j));
       if (close.empty()) {
         lower[static_cast<size_t>(t)] = band_len[i];
         continue;
@@ -121,7 +123,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
       sg.voxelize(o.triangle(t), bt, [&](std::int64_t id) {
         AABB centre;
         centre.lo = centre.hi = grid.center(id);
-        if (std::any_of(close.begin(), close.end(), [&](size_t j) { return within_band(centre, j); }))
+        if (std::any_of(close.begin(), close.end(), [&](size_t j) { return within(centre, j, centre_reach); }))
           hits[i].push_back({id, static_cast<Index>(i), t});
         else
           capped[i][static_cast<size_t>(t)] = 1;

@@ -25,7 +25,7 @@ struct VoronoiBounds {
   std::vector<std::vector<double>> triangle_lower;
   std::uint64_t sample_voxels = 0;
   /// Triangles with samples: those whose box lies within their object's band of another
-  /// object's box (the others get D_l = band without a sample).
+  /// object's triangle box (the others get D_l = band without a sample).
   std::uint64_t sampled_triangles = 0;
   double setup_ms = 0, upload_ms = 0, compute_ms = 0, readback_ms = 0, scan_ms = 0;
 };
