@@ -7,9 +7,11 @@
 #include "core/voronoi/radix_sort.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
+#include <utility>
 
 namespace vproxq {
 namespace {
@@ -21,11 +23,88 @@ constexpr double kMaxBandCells = 3.0;
 // Bins of this many voxels per side for the backends' triangle lookup (more on very fine
 // grids: bin_size_for()).
 constexpr std::int32_t kBinSize = 4;
+// Stage II's sampling filter asks each nearby object's triangle hierarchy while an object has
+// at most this many nearby objects (and a triangle half as many), else the owner grid.
+constexpr std::size_t kFewNearObjects = 8;
 
 struct VoxelHit {
   std::int64_t voxel;
   Index object;
   Index triangle;
+};
+
+/// Which objects' triangle boxes overlap each cell of a coarse grid over the scene (cells of
+/// two voxels, coarser where there would be more than kMaxCells): none, one (its id) or
+/// several. other_within() answers "may an object other than i have a triangle box within r
+/// of this box?" conservatively: a triangle box that comes within r of the box overlaps the
+/// box widened by r, hence a cell that the widened box overlaps (both cell ranges come from
+/// the same monotone rounding of coordinates).
+class OwnerGrid {
+ public:
+  static constexpr std::int32_t kEmpty = -1, kSeveral = -2;
+  static constexpr std::int64_t kMaxCells = std::int64_t{1} << 22;
+
+  OwnerGrid(const VoronoiGrid& grid, const FrameBoxes& boxes) : origin_(grid.origin) {
+    std::int32_t k = 2;
+    auto cells = [&](std::int32_t per) {
+      std::int64_t c = 1;
+      for (size_t a = 0; a < 3; ++a) c *= (grid.dims[a] + per - 1) / per;
+      return c;
+    };
+    while (cells(k) > kMaxCells) k *= 2;
+    width_ = grid.cell * k;
+    for (size_t a = 0; a < 3; ++a) dims_[a] = (grid.dims[a] + k - 1) / k;
+    owner_.assign(static_cast<size_t>(cells(k)), kEmpty);
+    for (size_t i = 0; i < boxes.triangles.size(); ++i) {
+      const auto id = static_cast<std::int32_t>(i);
+      for (const AABB& b : boxes.triangles[i]) {
+        const auto [lo, hi] = cell_range(b);
+        for (std::int32_t z = lo[2]; z <= hi[2]; ++z)
+          for (std::int32_t y = lo[1]; y <= hi[1]; ++y)
+            for (std::int32_t x = lo[0]; x <= hi[0]; ++x) {
+              std::int32_t& o = owner_[cell_id(x, y, z)];
+              o = o == kEmpty || o == id ? id : kSeveral;
+            }
+      }
+    }
+  }
+
+  bool other_within(const AABB& box, double r, Index i) const {
+    AABB wide = box;
+    wide.lo.array() -= r;
+    wide.hi.array() += r;
+    const auto [lo, hi] = cell_range(wide);
+    for (std::int32_t z = lo[2]; z <= hi[2]; ++z)
+      for (std::int32_t y = lo[1]; y <= hi[1]; ++y)
+        for (std::int32_t x = lo[0]; x <= hi[0]; ++x) {
+          const std::int32_t o = owner_[cell_id(x, y, z)];
+          if (o != kEmpty && o != static_cast<std::int32_t>(i)) return true;
+        }
+    return false;
+  }
+
+ private:
+  using Cell = std::array<std::int32_t, 3>;
+  std::pair<Cell, Cell> cell_range(const AABB& box) const {
+    Cell lo{}, hi{};
+    for (size_t a = 0; a < 3; ++a) {
+      auto cell_of = [&](double x) {
+        const double c = std::floor((x - origin_[static_cast<int>(a)]) / width_);
+        return static_cast<std::int32_t>(std::clamp(c, 0.0, static_cast<double>(dims_[a] - 1)));
+      };
+      lo[a] = cell_of(box.lo[static_cast<int>(a)]);
+      hi[a] = cell_of(box.hi[static_cast<int>(a)]);
+    }
+    return {lo, hi};
+  }
+  size_t cell_id(std::int32_t x, std::int32_t y, std::int32_t z) const {
+    return static_cast<size_t>(x + std::int64_t{dims_[0]} * (y + std::int64_t{dims_[1]} * z));
+  }
+
+  Vec3 origin_;
+  double width_ = 1;
+  Cell dims_{1, 1, 1};
+  std::vector<std::int32_t> owner_;
 };
 
 }  // namespace
@@ -79,6 +158,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   // sqrt(3) * half of it, and if that voxel counted as the band, every other triangle g has
   // d(p, g) >= d(c, box(g)) - sqrt(3) * half > band - δ. `near`: per object, the objects whose
   // boxes lie within its band of its box.
+  const OwnerGrid owners(grid, boxes);
   std::vector<std::vector<Index>> near(n);
   {
     const ObjectBoxTree& tree = boxes.object_tree();
@@ -109,21 +189,33 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
     // Voxel centres are computed in scene coordinates, a few ulps of the largest one off:
     // the rounding slack (~4.5e5 such ulps) keeps the test conservative.
     const double centre_reach = b + slack;
+    // Near few objects, through their triangle hierarchies; near many (a container, a floor),
+    // through the owner grid, whose cells are coarser but cost the same whatever the count.
+    const bool crowded = near[i].size() > kFewNearObjects;
     std::vector<size_t> close;  // the objects of near[i] within the band of triangle t
     for (Index t = 0; t < o.num_triangles(); ++t) {
       const AABB& bt = boxes.triangles[i][static_cast<size_t>(t)];
       close.clear();
-      for (const Index j : near[i])
-        if (within(bt, static_cast<size_t>(j), b)) close.push_back(static_cast<size_t>(j));
-      if (close.empty()) {
+      bool sample = false;
+      if (crowded) {
+        sample = owners.other_within(bt, b + slack, static_cast<Index>(i));
+      } else {
+        for (const Index j : near[i])
+          if (within(bt, static_cast<size_t>(j), b)) close.push_back(static_cast<size_t>(j));
+        sample = !close.empty();
+      }
+      if (!sample) {
         lower[static_cast<size_t>(t)] = band_len[i];
         continue;
       }
       ++sampled[i];
+      const bool by_owner = crowded || close.size() > kFewNearObjects / 2;
       sg.voxelize(o.triangle(t), bt, [&](std::int64_t id) {
         AABB centre;
         centre.lo = centre.hi = grid.center(id);
-        if (std::any_of(close.begin(), close.end(), [&](size_t j) { return within(centre, j, centre_reach); }))
+        const bool keep = by_owner ? owners.other_within(centre, centre_reach, static_cast<Index>(i))
+                                   : std::any_of(close.begin(), close.end(), [&](size_t j) { return within(centre, j, centre_reach); });
+        if (keep)
           hits[i].push_back({id, static_cast<Index>(i), t});
         else
           capped[i][static_cast<size_t>(t)] = 1;

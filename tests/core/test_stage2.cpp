@@ -12,6 +12,7 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace vproxq {
 namespace {
@@ -149,6 +150,47 @@ TEST(Stage2, LowerBoundsHoldWhereOnlyPartOfTheVoxelsAreSampled) {
         for (Index t = 0; t < frame.objects[i].num_triangles(); ++t)
           ASSERT_LE(vb.triangle_lower[i][static_cast<size_t>(t)], exact_triangle_separation(frame, i, t))
               << "object " << i << " triangle " << t;
+      }
+      InterDistanceOptions opts{2, &vb};
+      const auto got = inter_object_distance(frame, boxes, stage1, opts);
+      for (size_t i = 0; i < frame.objects.size(); ++i) {
+        EXPECT_EQ(got.per_object[i].nearest_object, ref.per_object[i].nearest_object);
+        EXPECT_EQ(got.per_object[i].distance, ref.per_object[i].distance);
+        EXPECT_EQ(got.per_object[i].triangles, ref.per_object[i].triangles);
+      }
+    }
+  }
+}
+
+// An object near many others (a floor under a crowd, a container) is filtered through the
+// owner grid, not through each neighbour's hierarchy: its bounds, and those of the grains
+// near it, must hold all the same.
+TEST(Stage2, LowerBoundsHoldForAnObjectNearManyOthers) {
+  auto backend = make_cpu_voronoi_backend(2);
+  for (std::uint64_t seed = 1; seed <= 2; ++seed) {
+    test::Rng rng(seed * 31);
+    Frame frame;
+    frame.objects.push_back(make_sheet(20, 6.0, "floor"));
+    for (int k = 0; k < 14; ++k) {
+      const Vec3 c(rng.uniform(0.5, 3.0), rng.uniform(0.5, 3.0), rng.uniform(-0.1, 0.5));
+      frame.objects.push_back(test::make_blob(rng, c, rng.uniform(0.15, 0.3), 1, 0.2, "grain" + std::to_string(k)));
+    }
+    const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
+    const ObjectBroadPhase stage1 = object_broad_phase(frame, boxes, 2);
+    const auto ref = inter_object_distance_brute_force(frame);
+    std::vector<std::vector<double>> exact(frame.objects.size());
+    for (size_t i = 0; i < frame.objects.size(); ++i)
+      for (Index t = 0; t < frame.objects[i].num_triangles(); ++t) exact[i].push_back(exact_triangle_separation(frame, i, t));
+    for (int grid : {8, 30, 90, 200}) {
+      SCOPED_TRACE("seed " + std::to_string(seed) + " grid " + std::to_string(grid));
+      const VoronoiBounds vb = compute_voronoi_bounds(frame, boxes, stage1, *backend, grid, 2);
+      // The floor's far half is sampled nowhere.
+      EXPECT_LT(vb.sampled_triangles, static_cast<std::uint64_t>(frame.objects[0].num_triangles()) +
+                                          static_cast<std::uint64_t>(14 * frame.objects[1].num_triangles()));
+      for (size_t i = 0; i < frame.objects.size(); ++i) {
+        EXPECT_GE(vb.object_upper[i], ref.per_object[i].distance) << "object " << i;
+        for (size_t t = 0; t < exact[i].size(); ++t)
+          ASSERT_LE(vb.triangle_lower[i][t], exact[i][t]) << "object " << i << " triangle " << t;
       }
       InterDistanceOptions opts{2, &vb};
       const auto got = inter_object_distance(frame, boxes, stage1, opts);
