@@ -82,6 +82,33 @@ Object make_sheet(int n, double size, const std::string& name) {
   return o;
 }
 
+/// The exact separation of every triangle from the other objects, [object][triangle].
+std::vector<std::vector<double>> exact_separations(const Frame& frame) {
+  std::vector<std::vector<double>> exact(frame.objects.size());
+  for (size_t i = 0; i < frame.objects.size(); ++i)
+    for (Index t = 0; t < frame.objects[i].num_triangles(); ++t) exact[i].push_back(exact_triangle_separation(frame, i, t));
+  return exact;
+}
+
+/// Lemma 2's bounds against brute force (`exact`: exact_separations(), `ref`: the brute-force
+/// inter-object distance), and Stage III with them gives brute force's answers.
+void expect_bounds_and_answers(const Frame& frame, const FrameBoxes& boxes, const ObjectBroadPhase& stage1,
+                               const VoronoiBounds& vb, const InterDistanceOutput& ref,
+                               const std::vector<std::vector<double>>& exact) {
+  for (size_t i = 0; i < frame.objects.size(); ++i) {
+    EXPECT_GE(vb.object_upper[i], ref.per_object[i].distance) << "object " << i;
+    for (size_t t = 0; t < exact[i].size(); ++t)
+      ASSERT_LE(vb.triangle_lower[i][t], exact[i][t]) << "object " << i << " triangle " << t;
+  }
+  InterDistanceOptions opts{2, &vb};
+  const auto got = inter_object_distance(frame, boxes, stage1, opts);
+  for (size_t i = 0; i < frame.objects.size(); ++i) {
+    EXPECT_EQ(got.per_object[i].nearest_object, ref.per_object[i].nearest_object);
+    EXPECT_EQ(got.per_object[i].distance, ref.per_object[i].distance);
+    EXPECT_EQ(got.per_object[i].triangles, ref.per_object[i].triangles);
+  }
+}
+
 // Stage II samples only where another object may lie within the band: a triangle whose box is
 // farther than its object's band from every other object's box is not sampled and gets
 // D_l = band (its samples could give at most band - δ), and of the others only the voxels
@@ -142,22 +169,11 @@ TEST(Stage2, LowerBoundsHoldWhereOnlyPartOfTheVoxelsAreSampled) {
     const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
     const ObjectBroadPhase stage1 = object_broad_phase(frame, boxes, 2);
     const auto ref = inter_object_distance_brute_force(frame);
+    const auto exact = exact_separations(frame);
     for (int grid : {6, 20, 48, 96}) {
       SCOPED_TRACE("seed " + std::to_string(seed) + " grid " + std::to_string(grid));
       const VoronoiBounds vb = compute_voronoi_bounds(frame, boxes, stage1, *backend, grid, 2);
-      for (size_t i = 0; i < frame.objects.size(); ++i) {
-        EXPECT_GE(vb.object_upper[i], ref.per_object[i].distance) << "object " << i;
-        for (Index t = 0; t < frame.objects[i].num_triangles(); ++t)
-          ASSERT_LE(vb.triangle_lower[i][static_cast<size_t>(t)], exact_triangle_separation(frame, i, t))
-              << "object " << i << " triangle " << t;
-      }
-      InterDistanceOptions opts{2, &vb};
-      const auto got = inter_object_distance(frame, boxes, stage1, opts);
-      for (size_t i = 0; i < frame.objects.size(); ++i) {
-        EXPECT_EQ(got.per_object[i].nearest_object, ref.per_object[i].nearest_object);
-        EXPECT_EQ(got.per_object[i].distance, ref.per_object[i].distance);
-        EXPECT_EQ(got.per_object[i].triangles, ref.per_object[i].triangles);
-      }
+      expect_bounds_and_answers(frame, boxes, stage1, vb, ref, exact);
     }
   }
 }
@@ -178,27 +194,14 @@ TEST(Stage2, LowerBoundsHoldForAnObjectNearManyOthers) {
     const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
     const ObjectBroadPhase stage1 = object_broad_phase(frame, boxes, 2);
     const auto ref = inter_object_distance_brute_force(frame);
-    std::vector<std::vector<double>> exact(frame.objects.size());
-    for (size_t i = 0; i < frame.objects.size(); ++i)
-      for (Index t = 0; t < frame.objects[i].num_triangles(); ++t) exact[i].push_back(exact_triangle_separation(frame, i, t));
+    const auto exact = exact_separations(frame);
     for (int grid : {8, 30, 90, 200}) {
       SCOPED_TRACE("seed " + std::to_string(seed) + " grid " + std::to_string(grid));
       const VoronoiBounds vb = compute_voronoi_bounds(frame, boxes, stage1, *backend, grid, 2);
       // The floor's far half is sampled nowhere.
       EXPECT_LT(vb.sampled_triangles, static_cast<std::uint64_t>(frame.objects[0].num_triangles()) +
                                           static_cast<std::uint64_t>(14 * frame.objects[1].num_triangles()));
-      for (size_t i = 0; i < frame.objects.size(); ++i) {
-        EXPECT_GE(vb.object_upper[i], ref.per_object[i].distance) << "object " << i;
-        for (size_t t = 0; t < exact[i].size(); ++t)
-          ASSERT_LE(vb.triangle_lower[i][t], exact[i][t]) << "object " << i << " triangle " << t;
-      }
-      InterDistanceOptions opts{2, &vb};
-      const auto got = inter_object_distance(frame, boxes, stage1, opts);
-      for (size_t i = 0; i < frame.objects.size(); ++i) {
-        EXPECT_EQ(got.per_object[i].nearest_object, ref.per_object[i].nearest_object);
-        EXPECT_EQ(got.per_object[i].distance, ref.per_object[i].distance);
-        EXPECT_EQ(got.per_object[i].triangles, ref.per_object[i].triangles);
-      }
+      expect_bounds_and_answers(frame, boxes, stage1, vb, ref, exact);
     }
   }
 }
