@@ -190,9 +190,12 @@ struct CcdSkipped {
 
 struct CcdCounters {
   std::uint64_t object_pairs = 0;     ///< object pairs (i <= j) whose swept boxes overlap
-  std::uint64_t triangle_pairs = 0;   ///< candidate triangle pairs after culling
+  /// Candidate triangle pairs after the box and Stage II per-triangle culling.
+  std::uint64_t triangle_pairs = 0;
   /// Of those, pairs shown apart for the whole step along a separating axis (no tests ran).
   std::uint64_t separated_pairs = 0;
+  /// Of the rest, pairs that share no Stage II (slot, voxel) key (no tests ran).
+  std::uint64_t unshared_pairs = 0;
   /// Primitive pairs (vertex–face, edge–edge) shown apart for the whole step along a
   /// separating axis (no test ran).
   std::uint64_t separated_primitives = 0;

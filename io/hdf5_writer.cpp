@@ -573,6 +573,7 @@ struct Hdf5ResultWriter::Impl {
     write_attribute(g, ccd_where, "object_pairs", std::uint64_t{k.object_pairs});
     write_attribute(g, ccd_where, "triangle_pairs", std::uint64_t{k.triangle_pairs});
     write_attribute(g, ccd_where, "separated_pairs", std::uint64_t{k.separated_pairs});
+    write_attribute(g, ccd_where, "unshared_pairs", std::uint64_t{k.unshared_pairs});
     write_attribute(g, ccd_where, "separated_primitives", std::uint64_t{k.separated_primitives});
     write_attribute(g, ccd_where, "culled_triangles", std::uint64_t{k.culled_triangles});
     write_attribute(g, ccd_where, "limit_hits", std::uint64_t{k.limit_hits});

@@ -92,6 +92,7 @@ Json ccd_stats_json(const CcdStepResult& c) {
   r["object_pairs"] = k.object_pairs;
   r["triangle_pairs"] = k.triangle_pairs;
   r["separated_pairs"] = k.separated_pairs;
+  r["unshared_pairs"] = k.unshared_pairs;
   r["separated_primitives"] = k.separated_primitives;
   r["culled_triangles"] = k.culled_triangles;
   r["limit_hits"] = k.limit_hits;

@@ -369,6 +369,7 @@ void add(CcdCounters& a, const CcdCounters& b) {
   a.limit_hits += b.limit_hits;
   a.culled_triangles += b.culled_triangles;
   a.separated_pairs += b.separated_pairs;
+  a.unshared_pairs += b.unshared_pairs;
   a.separated_primitives += b.separated_primitives;
 }
 
@@ -806,7 +807,6 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
         if (self && TriangleBvh::adjacent_subtree(pivot[static_cast<size_t>(j)][static_cast<size_t>(g)], f_pivots))
           return;  // a common pivot: no primitive pair to test
         if (voxels && (!self && !voxels->keeps(j, g))) return;
-        if (voxels && !voxels->share_voxel(i, f, j, g)) return;
         ++hits.counters.triangle_pairs;
         const Face& gf = oj.topology->faces[static_cast<size_t>(g)];
         const double margin = std::min(object_margin, f_share + ends_j.share[static_cast<size_t>(g)]);
@@ -815,6 +815,12 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
                                apart_gap) ||
             swept_apart(swept_f, swept_j[static_cast<size_t>(g)], apart_gap)) {
           ++hits.counters.separated_pairs;
+          return;
+        }
+        // After the separation tests, which are cheaper than merging two key lists and leave
+        // few pairs to it.
+        if (voxels && !voxels->share_voxel(i, f, j, g)) {
+          ++hits.counters.unshared_pairs;
           return;
         }
         const AABB g_raw = raw_box(vb_j, gf);

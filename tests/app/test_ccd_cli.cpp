@@ -138,7 +138,7 @@ TEST(CcdCli, BackendsGiveIdenticalResultsEqualToBruteForce) {
       if (!cpu["frames"][f]["stats"].contains("ccd")) continue;
       const auto& c = cpu["frames"][f]["stats"]["ccd"];
       const auto& g = gpu["frames"][f]["stats"]["ccd"];
-      for (const char* key : {"elementary_tests", "triangle_pairs", "culled_triangles", "object_pairs"})
+      for (const char* key : {"elementary_tests", "triangle_pairs", "unshared_pairs", "culled_triangles", "object_pairs"})
         EXPECT_EQ(c[key].get<std::uint64_t>(), g[key].get<std::uint64_t>()) << "frame " << f << " " << key;
       // The grid Stage II used is recorded (cells of 1/24 of the swept box's longest side, plus
       // the boundary cell); without Stage II there is none.
