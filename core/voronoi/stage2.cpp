@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 
@@ -158,7 +159,6 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   // sqrt(3) * half of it, and if that voxel counted as the band, every other triangle g has
   // d(p, g) >= d(c, box(g)) - sqrt(3) * half > band - δ. `near`: per object, the objects whose
   // boxes lie within its band of its box.
-  const OwnerGrid owners(grid, boxes);
   std::vector<std::vector<Index>> near(n);
   {
     const ObjectBoxTree& tree = boxes.object_tree();
@@ -171,6 +171,11 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
       });
     });
   }
+  // Built only where some object or triangle will read it (see below).
+  std::optional<OwnerGrid> owner_grid;
+  if (std::any_of(near.begin(), near.end(), [](const auto& v) { return v.size() > kFewNearObjects / 2; }))
+    owner_grid.emplace(grid, boxes);
+  const OwnerGrid* owners = owner_grid ? &*owner_grid : nullptr;
 
   // Conservative voxelization, per object in parallel, then merged in object order.
   std::vector<std::vector<VoxelHit>> hits(n);
@@ -198,7 +203,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
       close.clear();
       bool sample = false;
       if (crowded) {
-        sample = owners.other_within(bt, b + slack, static_cast<Index>(i));
+        sample = owners->other_within(bt, b + slack, static_cast<Index>(i));
       } else {
         for (const Index j : near[i])
           if (within(bt, static_cast<size_t>(j), b)) close.push_back(static_cast<size_t>(j));
@@ -213,7 +218,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
       sg.voxelize(o.triangle(t), bt, [&](std::int64_t id) {
         AABB centre;
         centre.lo = centre.hi = grid.center(id);
-        const bool keep = by_owner ? owners.other_within(centre, centre_reach, static_cast<Index>(i))
+        const bool keep = by_owner ? owners->other_within(centre, centre_reach, static_cast<Index>(i))
                                    : std::any_of(close.begin(), close.end(), [&](size_t j) { return within(centre, j, centre_reach); });
         if (keep)
           hits[i].push_back({id, static_cast<Index>(i), t});
