@@ -187,13 +187,18 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
     auto& lower = out.triangle_lower[i];
     capped[i].assign(lower.size(), 0);
     const double b = band_len[i];
-    // Whether object j has a triangle box within `reach` of `box`.
-    auto within = [&](const AABB& box, size_t j, double reach) {
-      return box_distance_squared(box, boxes.objects[j]) <= reach * reach && boxes.bvh(j).any_within(box, reach);
+    // Whether object j has a triangle box within r of `box`.
+    auto within = [&](const AABB& box, size_t j, double r) {
+      return box_distance_squared(box, boxes.objects[j]) <= r * r && boxes.bvh(j).any_within(box, r);
     };
-    // Voxel centres are computed in scene coordinates, a few ulps of the largest one off:
-    // the rounding slack (~4.5e5 such ulps) keeps the test conservative.
-    const double centre_reach = b + slack;
+    // The tests reach a little past the band, so that rounding cannot skip what lies within
+    // it: a voxel centre (origin + cell * (index + 1/2)) is within 2^-52 (M + E) of its exact
+    // value per coordinate (M: largest coordinate magnitude, E: grid extent), a widened box's
+    // corner within 2^-53 (M + reach), and a computed squared box distance within a relative
+    // 2^-50 of its exact value; so whatever a test leaves out lies farther than the band.
+    // (The frame's rounding slack, ~4.5e5 ulps of M, would do too, but far from the origin it
+    // spans the whole grid: 18 grains at 1e12 took 52 s of Stage II at --grid 512 with it.)
+    const double reach = b * (1 + 0x1p-48) + 0x1p-49 * (boxes.magnitude + sg.extent);
     // Near few objects, through their triangle hierarchies; near many (a container, a floor),
     // through the owner grid, whose cells are coarser but cost the same whatever the count.
     const bool crowded = near[i].size() > kFewNearObjects;
@@ -203,10 +208,10 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
       close.clear();
       bool sample = false;
       if (crowded) {
-        sample = owners->other_within(bt, b + slack, static_cast<Index>(i));
+        sample = owners->other_within(bt, reach, static_cast<Index>(i));
       } else {
         for (const Index j : near[i])
-          if (within(bt, static_cast<size_t>(j), b)) close.push_back(static_cast<size_t>(j));
+          if (within(bt, static_cast<size_t>(j), reach)) close.push_back(static_cast<size_t>(j));
         sample = !close.empty();
       }
       if (!sample) {
@@ -218,8 +223,8 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
       sg.voxelize(o.triangle(t), bt, [&](std::int64_t id) {
         AABB centre;
         centre.lo = centre.hi = grid.center(id);
-        const bool keep = by_owner ? owners->other_within(centre, centre_reach, static_cast<Index>(i))
-                                   : std::any_of(close.begin(), close.end(), [&](size_t j) { return within(centre, j, centre_reach); });
+        const bool keep = by_owner ? owners->other_within(centre, reach, static_cast<Index>(i))
+                                   : std::any_of(close.begin(), close.end(), [&](size_t j) { return within(centre, j, reach); });
         if (keep)
           hits[i].push_back({id, static_cast<Index>(i), t});
         else
