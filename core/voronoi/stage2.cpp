@@ -147,6 +147,16 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   std::vector<double> band_len(n);
   for (size_t i = 0; i < n; ++i)
     band_len[i] = std::min(stage1.upper_bound[i] + out.delta + slack, kMaxBandCells * grid.cell);
+  // The sampling filter's tests below reach a little past the band, so that rounding cannot
+  // skip what lies within it: a voxel centre (origin + cell * (index + 1/2)) is within
+  // 2^-52 (M + E) of its exact value per coordinate (M: largest coordinate magnitude, E: grid
+  // extent), a widened box's corner within 2^-53 (M + reach), and a computed squared box
+  // distance within a relative 2^-50 of its exact value; so whatever a test leaves out lies
+  // farther than the band. (The frame's rounding slack, ~4.5e5 ulps of M, would do too, but
+  // far from the origin it spans the whole grid: 18 grains at 1e12 took 52 s of Stage II at
+  // --grid 512 with it.)
+  std::vector<double> reach(n);
+  for (size_t i = 0; i < n; ++i) reach[i] = band_len[i] * (1 + 0x1p-48) + 0x1p-49 * (boxes.magnitude + sg.extent);
 
   // A sample point farther than its band from every other object gets the band back: the
   // backend's walk there finds nothing. So only where another object's triangle boxes come
@@ -158,14 +168,14 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   // point p of the triangle nearest to another object lies in a voxel whose centre c is within
   // sqrt(3) * half of it, and if that voxel counted as the band, every other triangle g has
   // d(p, g) >= d(c, box(g)) - sqrt(3) * half > band - δ. `near`: per object, the objects whose
-  // boxes lie within its band of its box.
+  // boxes lie within its reach of its box.
   std::vector<std::vector<Index>> near(n);
   {
     const ObjectBoxTree& tree = boxes.object_tree();
     parallel_for(n, threads, [&](size_t i) {
       if (boxes.objects[i].empty()) return;
-      const double b = band_len[i];
-      tree.bvh.query(boxes.objects[i], [b] { return b; }, [&](Index t, double) {
+      const double r = reach[i];
+      tree.bvh.query(boxes.objects[i], [r] { return r; }, [&](Index t, double) {
         const Index j = tree.ids[static_cast<size_t>(t)];
         if (j != static_cast<Index>(i)) near[i].push_back(j);
       });
@@ -186,19 +196,11 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
     const Object& o = frame.objects[i];
     auto& lower = out.triangle_lower[i];
     capped[i].assign(lower.size(), 0);
-    const double b = band_len[i];
-    // Whether object j has a triangle box within r of `box`.
-    auto within = [&](const AABB& box, size_t j, double r) {
-      return box_distance_squared(box, boxes.objects[j]) <= r * r && boxes.bvh(j).any_within(box, r);
+    // Whether object j has a triangle box within d of `box`.
+    auto within = [&](const AABB& box, size_t j, double d) {
+      return box_distance_squared(box, boxes.objects[j]) <= d * d && boxes.bvh(j).any_within(box, d);
     };
-    // The tests reach a little past the band, so that rounding cannot skip what lies within
-    // it: a voxel centre (origin + cell * (index + 1/2)) is within 2^-52 (M + E) of its exact
-    // value per coordinate (M: largest coordinate magnitude, E: grid extent), a widened box's
-    // corner within 2^-53 (M + reach), and a computed squared box distance within a relative
-    // 2^-50 of its exact value; so whatever a test leaves out lies farther than the band.
-    // (The frame's rounding slack, ~4.5e5 ulps of M, would do too, but far from the origin it
-    // spans the whole grid: 18 grains at 1e12 took 52 s of Stage II at --grid 512 with it.)
-    const double reach = b * (1 + 0x1p-48) + 0x1p-49 * (boxes.magnitude + sg.extent);
+    const double r = reach[i];
     // Near few objects, through their triangle hierarchies; near many (a container, a floor),
     // through the owner grid, whose cells are coarser but cost the same whatever the count.
     const bool crowded = near[i].size() > kFewNearObjects;
@@ -208,10 +210,10 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
       close.clear();
       bool sample = false;
       if (crowded) {
-        sample = owners->other_within(bt, reach, static_cast<Index>(i));
+        sample = owners->other_within(bt, r, static_cast<Index>(i));
       } else {
         for (const Index j : near[i])
-          if (within(bt, static_cast<size_t>(j), reach)) close.push_back(static_cast<size_t>(j));
+          if (within(bt, static_cast<size_t>(j), r)) close.push_back(static_cast<size_t>(j));
         sample = !close.empty();
       }
       if (!sample) {
@@ -223,8 +225,8 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
       sg.voxelize(o.triangle(t), bt, [&](std::int64_t id) {
         AABB centre;
         centre.lo = centre.hi = grid.center(id);
-        const bool keep = by_owner ? owners->other_within(centre, reach, static_cast<Index>(i))
-                                   : std::any_of(close.begin(), close.end(), [&](size_t j) { return within(centre, j, reach); });
+        const bool keep = by_owner ? owners->other_within(centre, r, static_cast<Index>(i))
+                                   : std::any_of(close.begin(), close.end(), [&](size_t j) { return within(centre, j, r); });
         if (keep)
           hits[i].push_back({id, static_cast<Index>(i), t});
         else
