@@ -207,9 +207,7 @@ struct OffsetStep {
 
 TEST(CcdStage2, DefaultCellAllowsForAMarginLargerThanTheTriangles) {
   const OffsetStep step(std::ldexp(1.0, 33));
-  const Frame& from = step.from;
-  const Frame& to = step.to;
-  const std::size_t triangles = step.triangles;
+  const auto& [from, to, triangles] = step;
   const CcdSweep sweep = CcdSweep::compute(from, to, 2);
   ASSERT_GT(sweep.margin, 0.5) << sweep.margin;  // larger than the scene's triangles (edges ~0.3-0.5)
   const CcdVoxelCulling voxels(from, to, sweep, 0, 2);
@@ -225,9 +223,7 @@ TEST(CcdStage2, DefaultCellAllowsForAMarginLargerThanTheTriangles) {
 // scene at 1e12, 200 ran out of memory.
 TEST(CcdStage2, GivenGridIsCoarsenedWhereTheMarginDwarfsTheTriangles) {
   const OffsetStep step(std::ldexp(1.0, 33));
-  const Frame& from = step.from;
-  const Frame& to = step.to;
-  const std::size_t triangles = step.triangles;
+  const auto& [from, to, triangles] = step;
   const CcdSweep sweep = CcdSweep::compute(from, to, 2);
   const CcdStepResult ref = continuous_collisions_brute_force(from, to);
   for (int grid : {16, 200, 4096}) {
