@@ -44,19 +44,48 @@ std::int32_t bin_size_for(const VoronoiGrid& grid, std::int32_t preferred) {
   return static_cast<std::int32_t>(side);
 }
 
-void bin_triangles(DvdInput& in, std::int32_t bin_size) {
+void set_bin_layout(DvdInput& in, std::int32_t bin_size) {
   if (bin_size < 1) {
     throw std::invalid_argument("bin_triangles: bin_size " + std::to_string(bin_size) +
                                 " is not positive");
   }
+  in.bin_size = bin_size;
+  for (std::size_t a = 0; a < 3; ++a) in.bin_dims[a] = (in.grid.dims[a] + bin_size - 1) / bin_size;
+}
+
+std::vector<std::uint8_t> reached_bins(const DvdInput& in) {
+  std::vector<std::uint8_t> reached(static_cast<std::size_t>(in.bin_dims[0]) *
+                                    static_cast<std::size_t>(in.bin_dims[1]) *
+                                    static_cast<std::size_t>(in.bin_dims[2]), 0);
+  BinRange last;
+  bool any = false;
+  for (std::size_t k = 0; k < in.voxels.size(); ++k) {
+    const BinRange r = bins_within(in, voxel_centre(in.grid, in.voxels[k]), in.band[k]);
+    // Neighbouring samples (the voxels are sorted) mostly reach the same bins.
+    if (any && r.lo == last.lo && r.hi == last.hi) continue;
+    any = true;
+    last = r;
+    for (std::int32_t z = r.lo[2]; z <= r.hi[2]; ++z)
+      for (std::int32_t y = r.lo[1]; y <= r.hi[1]; ++y)
+        for (std::int32_t x = r.lo[0]; x <= r.hi[0]; ++x) reached[static_cast<std::size_t>(bin_id(in, x, y, z))] = 1;
+  }
+  return reached;
+}
+
+bool reaches(const DvdInput& in, const std::vector<std::uint8_t>& reached, const BinRange& r) {
+  for (std::int32_t z = r.lo[2]; z <= r.hi[2]; ++z)
+    for (std::int32_t y = r.lo[1]; y <= r.hi[1]; ++y)
+      for (std::int32_t x = r.lo[0]; x <= r.hi[0]; ++x)
+        if (reached[static_cast<std::size_t>(bin_id(in, x, y, z))]) return true;
+  return false;
+}
+
+void bin_triangles(DvdInput& in, std::int32_t bin_size) {
+  set_bin_layout(in, bin_size);
   if (in.tri_xyz_d.size() % 9 != 0) {
     throw std::invalid_argument("bin_triangles: tri_xyz_d has " +
                                 std::to_string(in.tri_xyz_d.size()) +
                                 " numbers, not 9 per triangle");
-  }
-  in.bin_size = bin_size;
-  for (std::size_t a = 0; a < 3; ++a) {
-    in.bin_dims[a] = (in.grid.dims[a] + bin_size - 1) / bin_size;
   }
   const std::size_t bin_count = static_cast<std::size_t>(in.bin_dims[0]) *
                                 static_cast<std::size_t>(in.bin_dims[1]) *

@@ -11,6 +11,7 @@
 // enough to absorb it.
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "core/voronoi/discrete_voronoi.hpp"
 
@@ -22,6 +23,11 @@ namespace vproxq {
 /// within a bin. Throws std::invalid_argument when bin_size < 1, when tri_xyz_d is not 9
 /// numbers per triangle, or when the listing would exceed 2^31 - 1 entries.
 void bin_triangles(DvdInput& in, std::int32_t bin_size);
+
+/// Sets in.bin_size and in.bin_dims as bin_triangles() does, without listing any triangle (for
+/// reached_bins() before the triangles are chosen). Throws std::invalid_argument when
+/// bin_size < 1.
+void set_bin_layout(DvdInput& in, std::int32_t bin_size);
 
 /// Bins at most (2^24 bins: the CSR offsets are dense, 12 bytes per bin while binning).
 inline constexpr std::int64_t kMaxBins = std::int64_t{1} << 24;
@@ -50,6 +56,27 @@ std::int32_t bin_coordinate(const DvdInput& in, int axis, double x);
 
 /// Bins overlapping the box [lo, hi] (relative to the grid origin), clamped to the grid.
 BinRange bins_overlapping(const DvdInput& in, const Vec3& lo, const Vec3& hi);
+
+/// Centre of voxel `id`, relative to the grid origin: cell * (index + 0.5), as every backend
+/// computes it.
+inline Vec3 voxel_centre(const VoronoiGrid& grid, std::int64_t id) {
+  const std::int64_t x = id % grid.dims[0];
+  const std::int64_t y = (id / grid.dims[0]) % grid.dims[1];
+  const std::int64_t z = id / (std::int64_t{grid.dims[0]} * grid.dims[1]);
+  return grid.cell * Vec3(static_cast<double>(x) + 0.5, static_cast<double>(y) + 0.5,
+                          static_cast<double>(z) + 0.5);
+}
+
+/// Per bin of in's layout (set_bin_layout()), 1 where some sample's walk looks: the bins
+/// bins_within(voxel_centre(in.voxels[k]), in.band[k]) of every sample k. A backend reports,
+/// for a sample, only triangles closer than its band, and every such triangle's box overlaps
+/// one of those bins; so a triangle whose box overlaps no reached bin can be left out of the
+/// input without changing any output (Stage II leaves them out: most of a frame's triangles
+/// are far from every sample).
+std::vector<std::uint8_t> reached_bins(const DvdInput& in);
+
+/// Whether the range holds a bin that reached_bins() marked.
+bool reaches(const DvdInput& in, const std::vector<std::uint8_t>& reached, const BinRange& range);
 
 /// The bins to visit to find every triangle (in double coordinates tri_xyz_d) that has a point
 /// within distance `radius` of `point` (closed ball): bins_overlapping() of the box

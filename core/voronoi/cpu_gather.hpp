@@ -169,14 +169,4 @@ void for_each_nearest_first(const DvdInput& in, const Vec3& q,
   }
 }
 
-/// Centre of voxel `id`, relative to the grid origin: cell * (index + 0.5), as every backend
-/// computes it.
-inline Vec3 voxel_centre(const VoronoiGrid& grid, std::int64_t id) {
-  const std::int64_t x = id % grid.dims[0];
-  const std::int64_t y = (id / grid.dims[0]) % grid.dims[1];
-  const std::int64_t z = id / (std::int64_t{grid.dims[0]} * grid.dims[1]);
-  return grid.cell * Vec3(static_cast<double>(x) + 0.5, static_cast<double>(y) + 0.5,
-                          static_cast<double>(z) + 0.5);
-}
-
 }  // namespace vproxq

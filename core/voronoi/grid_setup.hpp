@@ -114,4 +114,8 @@ struct StageGrid {
 /// first triangle index of each object (size objects + 1).
 std::vector<std::int64_t> fill_dvd_triangles(DvdInput& in, const Frame& frame, const StageGrid& sg);
 
+/// The same for the triangles kept[i] of each object i only (ascending), in object order.
+void fill_dvd_triangles(DvdInput& in, const Frame& frame, const StageGrid& sg,
+                        const std::vector<std::vector<Index>>& kept);
+
 }  // namespace vproxq

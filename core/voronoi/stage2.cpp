@@ -278,9 +278,32 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   }
   out.sample_voxels = in.voxels.size();
 
-  // Triangles relative to the origin, in backend units, in object order.
-  fill_dvd_triangles(in, frame, sg);
-  bin_triangles(in, bin_size_for(in.grid, kBinSize));
+  // Triangles relative to the origin, in backend units, in object order: only those whose
+  // boxes overlap a bin that some sample's walk visits (reached_bins()); the backend reports
+  // only triangles within a sample's band, and those are all among them. Most triangles of a
+  // frame are far from every sample, and preparing them cost more than the samples did.
+  set_bin_layout(in, bin_size_for(in.grid, kBinSize));
+  const std::vector<std::uint8_t> reached = reached_bins(in);
+  std::vector<std::vector<Index>> kept(n);
+  parallel_for(n, threads, [&](size_t i) {
+    if (boxes.objects[i].empty()) return;
+    // The same bin ranges bin_triangles() computes from the backend coordinates: a box's
+    // bounds are corners' coordinates, mapped by the same monotone arithmetic.
+    auto range = [&](const AABB& b) {
+      Vec3 lo, hi;
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = (b.lo[k] - sg.grid.origin[k]) / sg.unit;
+        hi[k] = (b.hi[k] - sg.grid.origin[k]) / sg.unit;
+      }
+      return bins_overlapping(in, lo, hi);
+    };
+    if (!reaches(in, reached, range(boxes.objects[i]))) return;
+    const auto& tb = boxes.triangles[i];
+    for (size_t t = 0; t < tb.size(); ++t)
+      if (reaches(in, reached, range(tb[t]))) kept[i].push_back(static_cast<Index>(t));
+  });
+  fill_dvd_triangles(in, frame, sg, kept);
+  bin_triangles(in, in.bin_size);
   out.setup_ms = sw.elapsed_ms();
 
   const DvdOutput dvd = backend.compute(in);

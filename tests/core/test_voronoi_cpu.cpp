@@ -46,6 +46,7 @@ struct SceneOptions {
   int voxels = 2500;
   double max_band_cells = 6;
   std::int32_t bin_size = 4;
+  bool unbounded_bands = true;  ///< some bands 0, +infinity and 1e30
 };
 
 /// A random scene: triangles of several sites clustered around random centres inside the
@@ -103,9 +104,11 @@ DvdInput random_scene(unsigned seed, const SceneOptions& options) {
   in.voxels.assign(ids.begin(), ids.end());
   for (std::size_t k = 0; k < in.voxels.size(); ++k) {
     float band = static_cast<float>(unit(rng) * options.max_band_cells * in.grid.cell);
-    if (k % 101 == 0) band = 0.0f;
-    if (k % 103 == 1) band = std::numeric_limits<float>::infinity();
-    if (k % 107 == 2) band = 1e30f;
+    if (options.unbounded_bands) {
+      if (k % 101 == 0) band = 0.0f;
+      if (k % 103 == 1) band = std::numeric_limits<float>::infinity();
+      if (k % 107 == 2) band = 1e30f;
+    }
     in.band.push_back(band);
     // Every third voxel ignores one site (as Stage II does for a voxel of a single object).
     in.exclude_site.push_back(k % 3 == 0 ? pick_site(rng) : kNoIndex);
@@ -199,6 +202,38 @@ TEST(VoronoiCpu, ResultDoesNotDependOnBinSize) {
     const DvdInput in = random_scene(11, options);
     SCOPED_TRACE(testing::Message() << "bin size " << bin_size);
     expect_same(in, make_cpu_voronoi_backend(2)->compute(in), brute_force(in));
+  }
+}
+
+// Stage II leaves out of the backend's input the triangles whose boxes overlap no bin that a
+// sample's walk visits (reached_bins()): the output must be the twin's on all triangles.
+TEST(VoronoiCpu, TrianglesNoSampleReachesCanBeLeftOut) {
+  for (unsigned seed : {4u, 5u, 6u}) {
+    SceneOptions options;
+    options.voxels = 60;
+    options.max_band_cells = 3;  // Stage II's cap
+    options.unbounded_bands = false;
+    const DvdInput in = random_scene(seed, options);
+    const DvdOutput expected = brute_force(in);
+    DvdInput part = in;
+    part.tri_xyz.clear();
+    part.tri_xyz_d.clear();
+    part.tri_site.clear();
+    const std::vector<std::uint8_t> reached = reached_bins(in);
+    for (std::size_t t = 0; t < in.tri_site.size(); ++t) {
+      const Triangle tri = triangle_of(in, t);
+      const Vec3 lo = tri[0].cwiseMin(tri[1]).cwiseMin(tri[2]), hi = tri[0].cwiseMax(tri[1]).cwiseMax(tri[2]);
+      if (reaches(in, reached, bins_overlapping(in, lo, hi))) add_triangle(part, tri, in.tri_site[t]);
+    }
+    bin_triangles(part, options.bin_size);
+    SCOPED_TRACE(testing::Message() << "seed " << seed << ": " << part.tri_site.size() << " of "
+                                    << in.tri_site.size() << " triangles kept");
+    // Many triangles are left out, and the samples still see sites within their bands.
+    EXPECT_LT(4 * part.tri_site.size(), 3 * in.tri_site.size());
+    int found = 0;
+    for (std::size_t k = 0; k < in.voxels.size(); ++k) found += expected.site1[k] != kNoIndex;
+    EXPECT_GT(found, 10) << "of " << in.voxels.size();
+    expect_same(part, make_cpu_voronoi_backend(2)->compute(part), expected);
   }
 }
 
