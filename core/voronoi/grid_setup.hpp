@@ -8,9 +8,11 @@
 #include "core/voronoi/discrete_voronoi.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 namespace vproxq {
@@ -88,9 +90,14 @@ struct StageGrid {
   /// box `box`) touches, conservatively (see voxel_slack), in increasing (z, y, x) order.
   template <typename Visit>
   void voxelize(const Triangle& tri, const AABB& box, const Visit& visit) const {
-    Triangle rel = tri;
-    for (auto& p : rel) p -= grid.origin;
-    std::array<std::int32_t, 3> lo{}, hi{};
+    voxelize_cells(tri, box, [&](const Cell&, std::int64_t id) { visit(id); });
+  }
+
+  using Cell = std::array<std::int32_t, 3>;
+  /// The cells voxelize() visits for a triangle with bounding box `box` lie in this range
+  /// (inclusive); so do those of every triangle whose box lies inside `box`.
+  std::pair<Cell, Cell> cell_range(const AABB& box) const {
+    Cell lo{}, hi{};
     for (int k = 0; k < 3; ++k) {
       auto cell_of = [&](double x) {
         return std::clamp<std::int32_t>(static_cast<std::int32_t>(std::floor(x / grid.cell)), 0, grid.dims[k] - 1);
@@ -98,13 +105,22 @@ struct StageGrid {
       lo[k] = cell_of(box.lo[k] - grid.origin[k] - voxel_slack);
       hi[k] = cell_of(box.hi[k] - grid.origin[k] + voxel_slack);
     }
+    return {lo, hi};
+  }
+
+  /// voxelize(), calling visit(cell, linear id).
+  template <typename Visit>
+  void voxelize_cells(const Triangle& tri, const AABB& box, const Visit& visit) const {
+    Triangle rel = tri;
+    for (auto& p : rel) p -= grid.origin;
+    const auto [lo, hi] = cell_range(box);
     const TriangleBoxTester tester(rel, half);
     for (std::int32_t z = lo[2]; z <= hi[2]; ++z)
       for (std::int32_t y = lo[1]; y <= hi[1]; ++y)
         for (std::int32_t x = lo[0]; x <= hi[0]; ++x) {
           const Vec3 c = grid.cell * Vec3(x + 0.5, y + 0.5, z + 0.5);
           if (!tester.overlaps(c)) continue;
-          visit(x + std::int64_t{grid.dims[0]} * (y + std::int64_t{grid.dims[1]} * z));
+          visit(Cell{x, y, z}, x + std::int64_t{grid.dims[0]} * (y + std::int64_t{grid.dims[1]} * z));
         }
   }
 };

@@ -27,6 +27,9 @@ constexpr std::int32_t kBinSize = 4;
 // Stage II's sampling filter asks each nearby object's triangle hierarchy while an object has
 // at most this many nearby objects (and a triangle half as many), else the owner grid.
 constexpr std::size_t kFewNearObjects = 8;
+// The sampling filter remembers its per-voxel decisions over an object's range of cells up to
+// this many cells (a byte each).
+constexpr std::int64_t kMaxMemoCells = std::int64_t{1} << 22;
 
 struct VoxelHit {
   std::int64_t voxel;
@@ -183,7 +186,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   }
   // Built only where some object or triangle will read it (see below).
   std::optional<OwnerGrid> owner_grid;
-  if (std::any_of(near.begin(), near.end(), [](const auto& v) { return v.size() > kFewNearObjects / 2; }))
+  if (std::any_of(near.begin(), near.end(), [](const auto& v) { return v.size() > kFewNearObjects; }))
     owner_grid.emplace(grid, boxes);
   const OwnerGrid* owners = owner_grid ? &*owner_grid : nullptr;
 
@@ -204,30 +207,40 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
     // Near few objects, through their triangle hierarchies; near many (a container, a floor),
     // through the owner grid, whose cells are coarser but cost the same whatever the count.
     const bool crowded = near[i].size() > kFewNearObjects;
-    std::vector<size_t> close;  // the objects of near[i] within the band of triangle t
+    // Whether a voxel's centre lies within reach of another object's triangle box: decided once
+    // per voxel (neighbouring triangles share most of their voxels), against all of near[i]
+    // (a voxel kept or left out for one triangle is then so for all: either is sound for every
+    // triangle that touches it), remembered over the object's range of cells when not huge.
+    auto [clo, chi] = sg.cell_range(boxes.objects[i]);
+    std::array<std::int64_t, 3> span{};
+    for (size_t a = 0; a < 3; ++a) span[a] = std::int64_t{chi[a]} - clo[a] + 1;
+    const std::int64_t cells = span[0] * span[1] * span[2];
+    thread_local std::vector<std::uint8_t> memo;  // 0: not decided, 1: keep, 2: leave out
+    memo.assign(cells <= kMaxMemoCells ? static_cast<size_t>(cells) : 0, 0);
+    auto keep_voxel = [&](const StageGrid::Cell& c, std::int64_t id) {
+      std::uint8_t* m = nullptr;
+      if (!memo.empty()) {
+        m = &memo[static_cast<size_t>((c[0] - clo[0]) + span[0] * ((c[1] - clo[1]) + span[1] * std::int64_t{c[2] - clo[2]}))];
+        if (*m) return *m == 1;
+      }
+      AABB centre;
+      centre.lo = centre.hi = grid.center(id);
+      const bool keep = crowded ? owners->other_within(centre, r, static_cast<Index>(i))
+                                : std::any_of(near[i].begin(), near[i].end(), [&](Index j) { return within(centre, static_cast<size_t>(j), r); });
+      if (m) *m = keep ? 1 : 2;
+      return keep;
+    };
     for (Index t = 0; t < o.num_triangles(); ++t) {
       const AABB& bt = boxes.triangles[i][static_cast<size_t>(t)];
-      close.clear();
-      bool sample = false;
-      if (crowded) {
-        sample = owners->other_within(bt, r, static_cast<Index>(i));
-      } else {
-        for (const Index j : near[i])
-          if (within(bt, static_cast<size_t>(j), r)) close.push_back(static_cast<size_t>(j));
-        sample = !close.empty();
-      }
+      const bool sample = crowded ? owners->other_within(bt, r, static_cast<Index>(i))
+                                  : std::any_of(near[i].begin(), near[i].end(), [&](Index j) { return within(bt, static_cast<size_t>(j), r); });
       if (!sample) {
         lower[static_cast<size_t>(t)] = band_len[i];
         continue;
       }
       ++sampled[i];
-      const bool by_owner = crowded || close.size() > kFewNearObjects / 2;
-      sg.voxelize(o.triangle(t), bt, [&](std::int64_t id) {
-        AABB centre;
-        centre.lo = centre.hi = grid.center(id);
-        const bool keep = by_owner ? owners->other_within(centre, r, static_cast<Index>(i))
-                                   : std::any_of(close.begin(), close.end(), [&](size_t j) { return within(centre, j, r); });
-        if (keep)
+      sg.voxelize_cells(o.triangle(t), bt, [&](const StageGrid::Cell& c, std::int64_t id) {
+        if (keep_voxel(c, id))
           hits[i].push_back({id, static_cast<Index>(i), t});
         else
           capped[i][static_cast<size_t>(t)] = 1;
