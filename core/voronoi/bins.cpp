@@ -57,10 +57,26 @@ std::vector<std::uint8_t> reached_bins(const DvdInput& in) {
   std::vector<std::uint8_t> reached(static_cast<std::size_t>(in.bin_dims[0]) *
                                     static_cast<std::size_t>(in.bin_dims[1]) *
                                     static_cast<std::size_t>(in.bin_dims[2]), 0);
+  // In whole voxels: a sample at voxel v (centre (v + 1/2) cell) with band r visits bins of
+  // voxels floor(v + 1/2 -+ r' / cell), r' = r widened by kBinSearchSlack (bins_within()); every
+  // such voxel lies within v -+ k for k = ceil(r' / cell), whatever the rounding (it is far
+  // below the half voxel of margin). So marking the bins of v -+ k marks a superset.
+  const std::int32_t max_dim = std::max({in.grid.dims[0], in.grid.dims[1], in.grid.dims[2]});
+  const double extent = in.grid.cell * max_dim;
   BinRange last;
   bool any = false;
   for (std::size_t k = 0; k < in.voxels.size(); ++k) {
-    const BinRange r = bins_within(in, voxel_centre(in.grid, in.voxels[k]), in.band[k]);
+    const double widened = in.band[k] + kBinSearchSlack * (2 * extent + in.band[k]);
+    const double cells = std::ceil(widened / in.grid.cell);
+    const std::int64_t reach = cells < max_dim ? static_cast<std::int64_t>(cells) : max_dim;
+    const std::int64_t id = in.voxels[k];
+    const std::array<std::int64_t, 3> v{id % in.grid.dims[0], (id / in.grid.dims[0]) % in.grid.dims[1],
+                                        id / (std::int64_t{in.grid.dims[0]} * in.grid.dims[1])};
+    BinRange r;
+    for (std::size_t a = 0; a < 3; ++a) {
+      r.lo[a] = static_cast<std::int32_t>(std::max<std::int64_t>(v[a] - reach, 0) / in.bin_size);
+      r.hi[a] = static_cast<std::int32_t>(std::min<std::int64_t>(v[a] + reach, in.grid.dims[a] - 1) / in.bin_size);
+    }
     // Neighbouring samples (the voxels are sorted) mostly reach the same bins.
     if (any && r.lo == last.lo && r.hi == last.hi) continue;
     any = true;

@@ -67,8 +67,9 @@ inline Vec3 voxel_centre(const VoronoiGrid& grid, std::int64_t id) {
                           static_cast<double>(z) + 0.5);
 }
 
-/// Per bin of in's layout (set_bin_layout()), 1 where some sample's walk looks: the bins
-/// bins_within(voxel_centre(in.voxels[k]), in.band[k]) of every sample k. A backend reports,
+/// Per bin of in's layout (set_bin_layout()), 1 where some sample's walk may look: every bin
+/// of bins_within(voxel_centre(in.voxels[k]), in.band[k]) of every sample k (and some bins
+/// beside them: the ranges are taken in whole voxels around the sample's). A backend reports,
 /// for a sample, only triangles closer than its band, and every such triangle's box overlaps
 /// one of those bins; so a triangle whose box overlaps no reached bin can be left out of the
 /// input without changing any output (Stage II leaves them out: most of a frame's triangles

@@ -410,6 +410,38 @@ TEST(VoronoiBins, InfiniteRadiusVisitsEveryBin) {
   }
 }
 
+// reached_bins() marks every bin a sample's walk visits (bins_within() of its centre and band),
+// for bands of every size (0, a fraction of a cell, several bins, infinite), with several bin
+// sizes; and not every bin where the bands are small.
+TEST(VoronoiBins, ReachedBinsHoldEveryBinASampleVisits) {
+  for (const std::int32_t bin_size : {1, 3, 4}) {
+    SceneOptions options;
+    options.voxels = 300;
+    options.bin_size = bin_size;
+    DvdInput in = random_scene(43, options);
+    SCOPED_TRACE(testing::Message() << "bin size " << bin_size);
+    int missed = 0;
+    for (std::size_t k = 0; k < in.voxels.size(); ++k) {
+      // One sample at a time: the others' bins would hide a miss.
+      DvdInput one = in;
+      one.voxels = {in.voxels[k]};
+      one.band = {in.band[k]};
+      const std::vector<std::uint8_t> reached = reached_bins(one);
+      const BinRange r = bins_within(in, sample_point(in.grid, in.voxels[k]), in.band[k]);
+      for (std::int32_t z = r.lo[2]; z <= r.hi[2]; ++z)
+        for (std::int32_t y = r.lo[1]; y <= r.hi[1]; ++y)
+          for (std::int32_t x = r.lo[0]; x <= r.hi[0]; ++x) missed += !reached[static_cast<std::size_t>(bin_id(in, x, y, z))];
+    }
+    EXPECT_EQ(missed, 0);
+    // With small bands only (a cell at most), part of the grid stays unreached.
+    for (float& b : in.band) b = std::min(b, static_cast<float>(in.grid.cell));
+    in.voxels.resize(30);
+    in.band.resize(30);
+    const std::vector<std::uint8_t> few = reached_bins(in);
+    EXPECT_LT(std::count(few.begin(), few.end(), 1), static_cast<std::ptrdiff_t>(few.size()) / 2);
+  }
+}
+
 // bin_size_for(): the preferred side while the bins fit in kMaxBins, else the smallest side
 // that fits (so the one below it does not).
 TEST(VoronoiBins, BinSizeGrowsOnlyForVeryFineGrids) {
