@@ -1,5 +1,8 @@
 #include "core/voronoi/grid_setup.hpp"
 
+#include "core/parallel.hpp"
+#include "core/voronoi/bins.hpp"
+
 namespace vproxq {
 
 namespace {
@@ -43,6 +46,30 @@ void fill_dvd_triangles(DvdInput& in, const Frame& frame, const StageGrid& sg,
   g = 0;
   for (size_t i = 0; i < kept.size(); ++i)
     for (const Index t : kept[i]) put_triangle(in, frame, sg, i, t, g++);
+}
+
+std::vector<std::vector<Index>> reachable_triangles(const DvdInput& in, const StageGrid& sg,
+                                                    const FrameBoxes& boxes, int threads,
+                                                    const std::function<bool(size_t)>& wanted,
+                                                    const std::function<bool(size_t, Index)>& also) {
+  const std::vector<std::uint8_t> reached = reached_bins(in);
+  auto bins_of = [&](const AABB& b) {
+    Vec3 lo, hi;
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = (b.lo[k] - sg.grid.origin[k]) / sg.unit;
+      hi[k] = (b.hi[k] - sg.grid.origin[k]) / sg.unit;
+    }
+    return bins_overlapping(in, lo, hi);
+  };
+  std::vector<std::vector<Index>> kept(boxes.triangles.size());
+  parallel_for(kept.size(), threads, [&](size_t i) {
+    if (boxes.objects[i].empty() || !wanted(i)) return;
+    const bool any = reaches(in, reached, bins_of(boxes.objects[i]));
+    const auto& tb = boxes.triangles[i];
+    for (size_t t = 0; t < tb.size(); ++t)
+      if ((any && reaches(in, reached, bins_of(tb[t]))) || also(i, static_cast<Index>(t))) kept[i].push_back(static_cast<Index>(t));
+  });
+  return kept;
 }
 
 }  // namespace vproxq

@@ -3,6 +3,7 @@
 // the grid over the scene, the conservative voxelization of a triangle, and the triangle arrays
 // of a DvdInput.
 #include "core/broad_phase/aabb.hpp"
+#include "core/broad_phase/object_broad_phase.hpp"
 #include "core/geometry/triangle_box.hpp"
 #include "core/scene.hpp"
 #include "core/voronoi/discrete_voronoi.hpp"
@@ -11,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <utility>
 #include <vector>
@@ -133,5 +135,16 @@ std::vector<std::int64_t> fill_dvd_triangles(DvdInput& in, const Frame& frame, c
 /// The same for the triangles kept[i] of each object i only (ascending), in object order.
 void fill_dvd_triangles(DvdInput& in, const Frame& frame, const StageGrid& sg,
                         const std::vector<std::vector<Index>>& kept);
+
+/// Per object i with wanted(i), its triangles (ascending) whose boxes overlap a bin that
+/// reached_bins(in) marks, and those that also(i, t) asks for: the triangles a backend needs,
+/// since it reports only triangles closer than a sample's band, whose boxes overlap one of the
+/// bins the sample reaches. `in` needs its grid and bin layout (set_bin_layout()). The bins of
+/// a box are those bin_triangles() computes for the triangle: its bounds are corners'
+/// coordinates, mapped to backend units by the same monotone arithmetic as fill_dvd_triangles().
+std::vector<std::vector<Index>> reachable_triangles(const DvdInput& in, const StageGrid& sg,
+                                                    const FrameBoxes& boxes, int threads,
+                                                    const std::function<bool(size_t)>& wanted,
+                                                    const std::function<bool(size_t, Index)>& also);
 
 }  // namespace vproxq

@@ -25,7 +25,7 @@ constexpr double kMaxBandCells = 3.0;
 // grids: bin_size_for()).
 constexpr std::int32_t kBinSize = 4;
 // Stage II's sampling filter asks each nearby object's triangle hierarchy while an object has
-// at most this many nearby objects (and a triangle half as many), else the owner grid.
+// at most this many nearby objects, else the owner grid.
 constexpr std::size_t kFewNearObjects = 8;
 // The sampling filter remembers its per-voxel decisions over an object's range of cells up to
 // this many cells (a byte each).
@@ -184,7 +184,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
       });
     });
   }
-  // Built only where some object or triangle will read it (see below).
+  // Built only where some object will read it (see below).
   std::optional<OwnerGrid> owner_grid;
   if (std::any_of(near.begin(), near.end(), [](const auto& v) { return v.size() > kFewNearObjects; }))
     owner_grid.emplace(grid, boxes);
@@ -207,10 +207,10 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
     // Near few objects, through their triangle hierarchies; near many (a container, a floor),
     // through the owner grid, whose cells are coarser but cost the same whatever the count.
     const bool crowded = near[i].size() > kFewNearObjects;
-    // Whether a voxel's centre lies within reach of another object's triangle box: decided once
-    // per voxel (neighbouring triangles share most of their voxels), against all of near[i]
-    // (a voxel kept or left out for one triangle is then so for all: either is sound for every
-    // triangle that touches it), remembered over the object's range of cells when not huge.
+    // Whether a voxel's centre lies within reach of another object's triangle box, against all
+    // of near[i]: the answer does not depend on the triangle, so it is found once per voxel
+    // (neighbouring triangles share most of their voxels) and remembered over the object's
+    // range of cells (when that is not huge).
     auto [clo, chi] = sg.cell_range(boxes.objects[i]);
     std::array<std::int64_t, 3> span{};
     for (size_t a = 0; a < 3; ++a) span[a] = std::int64_t{chi[a]} - clo[a] + 1;
@@ -291,30 +291,12 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   }
   out.sample_voxels = in.voxels.size();
 
-  // Triangles relative to the origin, in backend units, in object order: only those whose
-  // boxes overlap a bin that some sample's walk visits (reached_bins()); the backend reports
-  // only triangles within a sample's band, and those are all among them. Most triangles of a
-  // frame are far from every sample, and preparing them cost more than the samples did.
+  // Triangles relative to the origin, in backend units, in object order: only those some
+  // sample's walk can reach (reachable_triangles()). Most triangles of a frame are far from
+  // every sample, and preparing them cost more than the samples did.
   set_bin_layout(in, bin_size_for(in.grid, kBinSize));
-  const std::vector<std::uint8_t> reached = reached_bins(in);
-  std::vector<std::vector<Index>> kept(n);
-  parallel_for(n, threads, [&](size_t i) {
-    if (boxes.objects[i].empty()) return;
-    // The same bin ranges bin_triangles() computes from the backend coordinates: a box's
-    // bounds are corners' coordinates, mapped by the same monotone arithmetic.
-    auto range = [&](const AABB& b) {
-      Vec3 lo, hi;
-      for (int k = 0; k < 3; ++k) {
-        lo[k] = (b.lo[k] - sg.grid.origin[k]) / sg.unit;
-        hi[k] = (b.hi[k] - sg.grid.origin[k]) / sg.unit;
-      }
-      return bins_overlapping(in, lo, hi);
-    };
-    if (!reaches(in, reached, range(boxes.objects[i]))) return;
-    const auto& tb = boxes.triangles[i];
-    for (size_t t = 0; t < tb.size(); ++t)
-      if (reaches(in, reached, range(tb[t]))) kept[i].push_back(static_cast<Index>(t));
-  });
+  const std::vector<std::vector<Index>> kept = reachable_triangles(
+      in, sg, boxes, threads, [](size_t) { return true; }, [](size_t, Index) { return false; });
   fill_dvd_triangles(in, frame, sg, kept);
   bin_triangles(in, in.bin_size);
   out.setup_ms = sw.elapsed_ms();
