@@ -55,14 +55,16 @@ Json intra_json(const IntraObjectDistance& d) {
   return r;
 }
 
-Json voronoi_stats_json(const VoronoiFrameStats& v) {
+/// A Stage II block of the frame's stats; `samples` (voxel-triangle samples) only for the self
+/// Stage II, whose samples are per triangle (the inter-object one samples each voxel once).
+Json voronoi_stats_json(const VoronoiFrameStats& v, bool samples) {
   Json vj;
   vj["grid"] = {v.grid_dims[0], v.grid_dims[1], v.grid_dims[2]};
   vj["cell"] = v.cell;
   vj["delta"] = v.delta;
   vj["delta_precision"] = v.delta_precision;
   vj["sample_voxels"] = v.sample_voxels;
-  vj["samples"] = v.samples;
+  if (samples) vj["samples"] = v.samples;
   if (v.sampled_triangles) vj["sampled_triangles"] = *v.sampled_triangles;
   vj["time_ms"] = {{"setup", v.setup_ms}, {"upload", v.upload_ms}, {"compute", v.compute_ms},
                    {"readback", v.readback_ms}, {"scan", v.scan_ms}};
@@ -224,20 +226,8 @@ Json frame_json(const FrameResult& frame, double write_ms) {
     stats["intra_separation_culled"] = frame.counters.intra_separation_culled;
     stats["intra_reused"] = frame.counters.intra_reused;
   }
-  if (frame.voronoi) {
-    const VoronoiFrameStats& v = *frame.voronoi;
-    Json vj;
-    vj["grid"] = {v.grid_dims[0], v.grid_dims[1], v.grid_dims[2]};
-    vj["cell"] = v.cell;
-    vj["delta"] = v.delta;
-    vj["delta_precision"] = v.delta_precision;
-    vj["sample_voxels"] = v.sample_voxels;
-    if (v.sampled_triangles) vj["sampled_triangles"] = *v.sampled_triangles;
-    vj["time_ms"] = {{"setup", v.setup_ms}, {"upload", v.upload_ms}, {"compute", v.compute_ms},
-                     {"readback", v.readback_ms}, {"scan", v.scan_ms}};
-    stats["voronoi"] = std::move(vj);
-  }
-  if (frame.self_voronoi) stats["self_voronoi"] = voronoi_stats_json(*frame.self_voronoi);
+  if (frame.voronoi) stats["voronoi"] = voronoi_stats_json(*frame.voronoi, false);
+  if (frame.self_voronoi) stats["self_voronoi"] = voronoi_stats_json(*frame.self_voronoi, true);
   if (frame.ccd) stats["ccd"] = ccd_stats_json(*frame.ccd);
   j["stats"] = std::move(stats);
   return j;
