@@ -144,6 +144,7 @@ VoronoiFrameStats frame_stats(const Bounds& b, std::uint64_t samples) {
   v.delta_precision = b.delta_precision;
   v.sample_voxels = b.sample_voxels;
   v.samples = samples;
+  v.backend_triangles = b.backend_triangles;
   v.setup_ms = b.setup_ms;
   v.upload_ms = b.upload_ms;
   v.compute_ms = b.compute_ms;

@@ -85,6 +85,7 @@ struct VoronoiFrameStats {
   std::uint64_t samples = 0;  ///< samples evaluated: (voxel, triangle) pairs for the self Stage II, = sample_voxels for the inter-object one
   /// Self Stage II only: triangles sampled (2-ring bound above δ); none for the inter-object one.
   std::optional<std::uint64_t> sampled_triangles;
+  std::uint64_t backend_triangles = 0;  ///< triangles passed to the backend (those a sample can reach)
   double setup_ms = 0, upload_ms = 0, compute_ms = 0, readback_ms = 0, scan_ms = 0;
 };
 

@@ -620,6 +620,7 @@ struct Hdf5ResultWriter::Impl {
       write_attribute(s, stats_where, "voronoi_delta_precision", v.delta_precision);
       write_attribute(s, stats_where, "voronoi_sample_voxels", std::uint64_t{v.sample_voxels});
       write_attribute(s, stats_where, "voronoi_sampled_triangles", v.sampled_triangles.value_or(0));
+      write_attribute(s, stats_where, "voronoi_backend_triangles", std::uint64_t{v.backend_triangles});
       write_attribute(s, stats_where, "voronoi_time_ms_upload", v.upload_ms);
       write_attribute(s, stats_where, "voronoi_time_ms_compute", v.compute_ms);
       write_attribute(s, stats_where, "voronoi_time_ms_readback", v.readback_ms);
@@ -641,6 +642,7 @@ struct Hdf5ResultWriter::Impl {
       write_attribute(s, stats_where, "self_voronoi_delta", v.delta);
       write_attribute(s, stats_where, "self_voronoi_samples", std::uint64_t{v.samples});
       write_attribute(s, stats_where, "self_voronoi_sampled_triangles", v.sampled_triangles.value_or(0));
+      write_attribute(s, stats_where, "self_voronoi_backend_triangles", std::uint64_t{v.backend_triangles});
       write_attribute(s, stats_where, "self_voronoi_time_ms_compute", v.compute_ms);
     }
     close_checked(stats, "H5Gclose", stats_where);

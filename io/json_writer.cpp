@@ -66,6 +66,7 @@ Json voronoi_stats_json(const VoronoiFrameStats& v, bool samples) {
   vj["sample_voxels"] = v.sample_voxels;
   if (samples) vj["samples"] = v.samples;
   if (v.sampled_triangles) vj["sampled_triangles"] = *v.sampled_triangles;
+  vj["backend_triangles"] = v.backend_triangles;
   vj["time_ms"] = {{"setup", v.setup_ms}, {"upload", v.upload_ms}, {"compute", v.compute_ms},
                    {"readback", v.readback_ms}, {"scan", v.scan_ms}};
   return vj;

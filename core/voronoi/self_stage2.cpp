@@ -206,6 +206,7 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
       in.dvd, sg, boxes, threads, [&](size_t i) { return sampled[i] > 0; },
       [&](size_t i, Index t) { return is_sample[static_cast<size_t>(tri_base[i] + t)] != 0; });
   fill_dvd_triangles(in.dvd, frame, sg, kept);
+  out.backend_triangles = in.dvd.tri_site.size();
   std::vector<std::int32_t> local(tri_count, -1);  // global id -> input triangle
   in.tri_vertices.reserve(3 * in.dvd.tri_site.size());
   for (size_t i = 0, next = 0; i < n; ++i) {

@@ -74,6 +74,9 @@ struct SelfVoronoiBounds {
   std::uint64_t samples = 0;        ///< (voxel, triangle) pairs evaluated
   std::uint64_t sampled_triangles = 0;  ///< triangles with samples: those whose 2-ring bound exceeds δ
   std::uint64_t sample_voxels = 0;  ///< distinct voxels among them
+  /// Triangles passed to the backend: the sampled ones and those of their objects that some
+  /// sample's walk can reach (reachable_triangles()).
+  std::uint64_t backend_triangles = 0;
   double setup_ms = 0, upload_ms = 0, compute_ms = 0, readback_ms = 0, scan_ms = 0;
 };
 

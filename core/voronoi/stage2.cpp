@@ -298,6 +298,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   const std::vector<std::vector<Index>> kept = reachable_triangles(
       in, sg, boxes, threads, [](size_t) { return true; }, [](size_t, Index) { return false; });
   fill_dvd_triangles(in, frame, sg, kept);
+  out.backend_triangles = in.tri_site.size();
   bin_triangles(in, in.bin_size);
   out.setup_ms = sw.elapsed_ms();
 

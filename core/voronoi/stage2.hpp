@@ -27,6 +27,8 @@ struct VoronoiBounds {
   /// Triangles with samples: those whose box lies within their object's band of another
   /// object's triangle box (the others get D_l = band without a sample).
   std::uint64_t sampled_triangles = 0;
+  /// Triangles passed to the backend: those some sample's walk can reach (reachable_triangles()).
+  std::uint64_t backend_triangles = 0;
   double setup_ms = 0, upload_ms = 0, compute_ms = 0, readback_ms = 0, scan_ms = 0;
 };
 

@@ -74,10 +74,14 @@ TEST(CliIntra, JsonAndHdf5EqualBruteForceWithEveryBackend) {
           for (size_t t = 0; t < ring2[i].size(); ++t)
             want += ring2[i][t] > kSelfSampleRing2OverDelta * delta && test::has_non_adjacent(frame.objects[i], static_cast<Index>(t));
       EXPECT_EQ(sv["sampled_triangles"].get<std::uint64_t>(), want);
-      // The inter-object stage's: at most every triangle of the frame.
+      // The inter-object stage's: at most every triangle of the frame; the backends get the
+      // sampled triangles (and those a sample can reach), at most all.
       std::uint64_t triangles = 0;
       for (const Object& o : frame.objects) triangles += static_cast<std::uint64_t>(o.num_triangles());
       EXPECT_LE(j["frames"][0]["stats"]["voronoi"]["sampled_triangles"].get<std::uint64_t>(), triangles);
+      EXPECT_LE(j["frames"][0]["stats"]["voronoi"]["backend_triangles"].get<std::uint64_t>(), triangles);
+      EXPECT_GE(sv["backend_triangles"].get<std::uint64_t>(), want);
+      EXPECT_LE(sv["backend_triangles"].get<std::uint64_t>(), triangles);
     }
 
     // HDF5: the per-triangle table, object-major.

@@ -127,6 +127,11 @@ TEST(Stage2, OnlyTrianglesNearAnotherObjectAreSampled) {
     const double near_voxels = (reach / cell + Vec3::Ones()).prod();
     EXPECT_LE(static_cast<double>(vb.sample_voxels), near_voxels);
     EXPECT_LT(vb.sampled_triangles, static_cast<std::uint64_t>(frame.objects[0].num_triangles() / 4));
+    // The backend gets the blob and the sheet's triangles near it only (in bins of 4 cells
+    // around the samples: at grid 16 a quarter of the sheet's bins).
+    const auto blob = static_cast<std::uint64_t>(frame.objects[1].num_triangles());
+    ASSERT_GE(vb.backend_triangles, blob);
+    EXPECT_LT(vb.backend_triangles - blob, static_cast<std::uint64_t>(frame.objects[0].num_triangles() / 2));
     const double band0 = std::min(stage1.upper_bound[0] + vb.delta, 3 * cell);
     Index far = 0;
     for (size_t i = 0; i < 2; ++i) {
