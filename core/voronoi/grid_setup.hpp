@@ -101,8 +101,10 @@ struct StageGrid {
   std::pair<Cell, Cell> cell_range(const AABB& box) const {
     Cell lo{}, hi{};
     for (int k = 0; k < 3; ++k) {
+      // Clamped in double before the conversion: an empty box's infinite bounds (an object
+      // without triangles) must not reach the int conversion.
       auto cell_of = [&](double x) {
-        return std::clamp<std::int32_t>(static_cast<std::int32_t>(std::floor(x / grid.cell)), 0, grid.dims[k] - 1);
+        return static_cast<std::int32_t>(std::clamp(std::floor(x / grid.cell), 0.0, static_cast<double>(grid.dims[k] - 1)));
       };
       lo[k] = cell_of(box.lo[k] - grid.origin[k] - voxel_slack);
       hi[k] = cell_of(box.hi[k] - grid.origin[k] + voxel_slack);

@@ -199,6 +199,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
     const Object& o = frame.objects[i];
     auto& lower = out.triangle_lower[i];
     capped[i].assign(lower.size(), 0);
+    if (o.num_triangles() == 0) return;
     // Whether object j has a triangle box within d of `box`.
     auto within = [&](const AABB& box, size_t j, double d) {
       return box_distance_squared(box, boxes.objects[j]) <= d * d && boxes.bvh(j).any_within(box, d);

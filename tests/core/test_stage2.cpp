@@ -103,6 +103,23 @@ TEST(Stage2, BoundsHoldAndResultsEqualBruteForce) {
   }
 }
 
+// An object without triangles (between two others) is never sampled and never a site; the
+// others' bounds hold.
+TEST(Stage2, AnObjectWithoutTrianglesIsLeftAlone) {
+  test::Rng rng(3);
+  Frame frame;
+  frame.objects.push_back(test::make_blob(rng, Vec3(0, 0, 0), 0.5, 1, 0.1, "a"));
+  Object empty;
+  empty.name = "empty";
+  empty.topology = std::make_shared<Topology>();
+  frame.objects.push_back(std::move(empty));
+  frame.objects.push_back(test::make_blob(rng, Vec3(1.1, 0.2, 0), 0.5, 1, 0.1, "b"));
+  expect_bounds_at_grids(frame, {4, 16, 32}, "with an empty object", [](const VoronoiBounds& vb) {
+    EXPECT_TRUE(vb.triangle_lower[1].empty());
+    EXPECT_GT(vb.sample_voxels, 0u);
+  });
+}
+
 // Stage II samples only where another object may lie within the band: a triangle whose box is
 // farther than its object's band from every other object's box is not sampled and gets
 // D_l = band (its samples could give at most band - δ), and of the others only the voxels
