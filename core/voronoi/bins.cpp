@@ -57,17 +57,19 @@ std::vector<std::uint8_t> reached_bins(const DvdInput& in) {
   std::vector<std::uint8_t> reached(static_cast<std::size_t>(in.bin_dims[0]) *
                                     static_cast<std::size_t>(in.bin_dims[1]) *
                                     static_cast<std::size_t>(in.bin_dims[2]), 0);
-  // In whole voxels: a sample at voxel v (centre (v + 1/2) cell) with band r visits bins of
-  // voxels floor(v + 1/2 -+ r' / cell), r' = r widened by kBinSearchSlack (bins_within()); every
-  // such voxel lies within v -+ k for k = ceil(r' / cell), whatever the rounding (it is far
-  // below the half voxel of margin). So marking the bins of v -+ k marks a superset.
+  // In whole voxels: a sample at voxel v (centre (v + 1/2) cell) with band r visits the bins of
+  // voxels floor(v + 1/2 -+ x) with x = r' / cell, r' = r widened by kBinSearchSlack
+  // (bins_within()), up to the rounding of that expression, a few 2^-53 of its magnitude (at
+  // most the grid's dims): below 1e-6. Those voxels lie within v -+ k for k = floor(x + 1/2 +
+  // 1e-6) (floor(v + 1/2 + x + e) <= v + k, and floor(v + 1/2 - x - e) >= v - k since
+  // floor(y) + 1 > y). So marking the bins of v -+ k marks a superset.
   const std::int32_t max_dim = std::max({in.grid.dims[0], in.grid.dims[1], in.grid.dims[2]});
   const double extent = in.grid.cell * max_dim;
   BinRange last;
   bool any = false;
   for (std::size_t k = 0; k < in.voxels.size(); ++k) {
     const double widened = in.band[k] + kBinSearchSlack * (2 * extent + in.band[k]);
-    const double cells = std::ceil(widened / in.grid.cell);
+    const double cells = std::floor(widened / in.grid.cell + 0.5 + 1e-6);
     const std::int64_t reach = cells < max_dim ? static_cast<std::int64_t>(cells) : max_dim;
     const std::int64_t id = in.voxels[k];
     const std::array<std::int64_t, 3> v{id % in.grid.dims[0], (id / in.grid.dims[0]) % in.grid.dims[1],
