@@ -12,37 +12,22 @@ void put_triangle(DvdInput& in, const Frame& frame, const StageGrid& sg, size_t 
   const Triangle tri = frame.objects[i].triangle(t);
   for (int c = 0; c < 3; ++c)
     for (int k = 0; k < 3; ++k) {
-      const double v = (tri[static_cast<size_t>(c)][k] - sg.grid.origin[k]) / sg.unit;
+      const double v = sg.backend_coord(tri[static_cast<size_t>(c)][k], k);
       in.tri_xyz_d[g * 9 + static_cast<size_t>(c * 3 + k)] = v;
       in.tri_xyz[g * 9 + static_cast<size_t>(c * 3 + k)] = static_cast<float>(v);
     }
   in.tri_site[g] = static_cast<std::int32_t>(i);
 }
 
-void resize_triangles(DvdInput& in, std::int64_t count) {
-  in.tri_xyz.resize(static_cast<size_t>(count) * 9);
-  in.tri_xyz_d.resize(in.tri_xyz.size());
-  in.tri_site.resize(static_cast<size_t>(count));
-}
-
 }  // namespace
-
-std::vector<std::int64_t> fill_dvd_triangles(DvdInput& in, const Frame& frame, const StageGrid& sg) {
-  const size_t n = frame.objects.size();
-  std::vector<std::int64_t> tri_base(n + 1, 0);
-  for (size_t i = 0; i < n; ++i) tri_base[i + 1] = tri_base[i] + frame.objects[i].num_triangles();
-  resize_triangles(in, tri_base[n]);
-  for (size_t i = 0; i < n; ++i)
-    for (Index t = 0; t < frame.objects[i].num_triangles(); ++t)
-      put_triangle(in, frame, sg, i, t, static_cast<size_t>(tri_base[i] + t));
-  return tri_base;
-}
 
 void fill_dvd_triangles(DvdInput& in, const Frame& frame, const StageGrid& sg,
                         const std::vector<std::vector<Index>>& kept) {
   size_t g = 0;
   for (const auto& k : kept) g += k.size();
-  resize_triangles(in, static_cast<std::int64_t>(g));
+  in.tri_xyz.resize(g * 9);
+  in.tri_xyz_d.resize(g * 9);
+  in.tri_site.resize(g);
   g = 0;
   for (size_t i = 0; i < kept.size(); ++i)
     for (const Index t : kept[i]) put_triangle(in, frame, sg, i, t, g++);
@@ -56,8 +41,8 @@ std::vector<std::vector<Index>> reachable_triangles(const DvdInput& in, const St
   auto bins_of = [&](const AABB& b) {
     Vec3 lo, hi;
     for (int k = 0; k < 3; ++k) {
-      lo[k] = (b.lo[k] - sg.grid.origin[k]) / sg.unit;
-      hi[k] = (b.hi[k] - sg.grid.origin[k]) / sg.unit;
+      lo[k] = sg.backend_coord(b.lo[k], k);
+      hi[k] = sg.backend_coord(b.hi[k], k);
     }
     return bins_overlapping(in, lo, hi);
   };

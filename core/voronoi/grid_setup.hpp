@@ -78,6 +78,10 @@ struct StageGrid {
     return unit * backend.distance_error_bound(extent / unit);
   }
 
+  /// Coordinate x along axis k in backend units, relative to the origin: every triangle corner
+  /// and box bound a backend sees goes through this one monotone map.
+  double backend_coord(double x, int k) const { return (x - grid.origin[k]) / unit; }
+
   /// `length` (scene units) as a float in backend units, rounded up: never below the double.
   float backend_band(double length) const {
     const float f = static_cast<float>(length / unit);
@@ -129,12 +133,9 @@ struct StageGrid {
   }
 };
 
-/// Fills in.tri_xyz, in.tri_xyz_d (relative to sg.grid.origin, in backend units) and
-/// in.tri_site (object id) with every triangle of the frame, in object order. Returns the
-/// first triangle index of each object (size objects + 1).
-std::vector<std::int64_t> fill_dvd_triangles(DvdInput& in, const Frame& frame, const StageGrid& sg);
-
-/// The same for the triangles kept[i] of each object i only (ascending), in object order.
+/// Fills in.tri_xyz, in.tri_xyz_d (relative to sg.grid.origin, in backend units:
+/// backend_coord()) and in.tri_site (object id) with the triangles kept[i] of each object i
+/// (ascending), in object order.
 void fill_dvd_triangles(DvdInput& in, const Frame& frame, const StageGrid& sg,
                         const std::vector<std::vector<Index>>& kept);
 
@@ -143,7 +144,7 @@ void fill_dvd_triangles(DvdInput& in, const Frame& frame, const StageGrid& sg,
 /// since it reports only triangles closer than a sample's band, whose boxes overlap one of the
 /// bins the sample reaches. `in` needs its grid and bin layout (set_bin_layout()). The bins of
 /// a box are those bin_triangles() computes for the triangle: its bounds are corners'
-/// coordinates, mapped to backend units by the same monotone arithmetic as fill_dvd_triangles().
+/// coordinates, mapped to backend units by the same backend_coord().
 std::vector<std::vector<Index>> reachable_triangles(const DvdInput& in, const StageGrid& sg,
                                                     const FrameBoxes& boxes, int threads,
                                                     const std::function<bool(size_t)>& wanted,

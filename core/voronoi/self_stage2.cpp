@@ -143,8 +143,9 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
   // 58K (skirt), 362K -> 118K (cloth-ball), 188K -> 46K (breaking); on the 200-object scene
   // 214K -> 1.4K and self Stage II 121 -> 10 ms per frame, 0 culls either way. Nor are
   // triangles that share a vertex with every other triangle of their object
-  // (may_have_candidate()): they have no answer and are no other triangle's candidate. An unsampled triangle keeps D_u = 2-ring
-  // bound and D_l = -inf: less culling, never a different answer.
+  // (may_have_candidate()): they have no answer and are no other triangle's candidate. An
+  // unsampled triangle keeps D_u = 2-ring bound and D_l = -inf: less culling, never a
+  // different answer.
   std::vector<std::vector<Sample>> hits(n);
   std::vector<std::uint64_t> sampled(n, 0);
   parallel_for(n, threads, [&](size_t i) {

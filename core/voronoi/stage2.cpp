@@ -208,6 +208,11 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
     // Near few objects, through their triangle hierarchies; near many (a container, a floor),
     // through the owner grid, whose cells are coarser but cost the same whatever the count.
     const bool crowded = near[i].size() > kFewNearObjects;
+    // Whether another object's triangle box lies within reach of `box`.
+    auto other_within = [&](const AABB& box) {
+      return crowded ? owners->other_within(box, r, static_cast<Index>(i))
+                     : std::any_of(near[i].begin(), near[i].end(), [&](Index j) { return within(box, static_cast<size_t>(j), r); });
+    };
     // Whether a voxel's centre lies within reach of another object's triangle box, against all
     // of near[i]: the answer does not depend on the triangle, so it is found once per voxel
     // (neighbouring triangles share most of their voxels) and remembered over the object's
@@ -226,16 +231,13 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
       }
       AABB centre;
       centre.lo = centre.hi = grid.center(id);
-      const bool keep = crowded ? owners->other_within(centre, r, static_cast<Index>(i))
-                                : std::any_of(near[i].begin(), near[i].end(), [&](Index j) { return within(centre, static_cast<size_t>(j), r); });
+      const bool keep = other_within(centre);
       if (m) *m = keep ? 1 : 2;
       return keep;
     };
     for (Index t = 0; t < o.num_triangles(); ++t) {
       const AABB& bt = boxes.triangles[i][static_cast<size_t>(t)];
-      const bool sample = crowded ? owners->other_within(bt, r, static_cast<Index>(i))
-                                  : std::any_of(near[i].begin(), near[i].end(), [&](Index j) { return within(bt, static_cast<size_t>(j), r); });
-      if (!sample) {
+      if (!other_within(bt)) {
         lower[static_cast<size_t>(t)] = band_len[i];
         continue;
       }
