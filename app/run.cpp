@@ -282,25 +282,16 @@ void run(const Config& config) {
       // another order, pieces of broken meshes by their vertices (ccd_counterparts()).
       const std::optional<Frame> reordered = ccd_counterparts(frame, *next_frame);
       const Frame& to = reordered ? *reordered : *next_frame;
-      // Stage II for CCD: records on the host, voxels and co-occupancy on the backend.
       sw.restart();
       const CcdSweep sweep = CcdSweep::compute(frame, to, info.threads);
       const double sweep_ms = sw.elapsed_ms();
-      std::optional<CcdVoxelCulling> voxels;
-      double voxel_ms = 0;
-      if (voronoi.backend) {
-        sw.restart();
-        voxels.emplace(frame, to, sweep, CcdVoxelOptions{grid, 0, info.threads}, *voronoi.ccd_backend);
-        voxel_ms = sw.elapsed_ms();
-      }
-      CcdStepResult c = continuous_collisions(frame, to, sweep,
-                                              CcdOptions{info.threads, voxels ? &*voxels : nullptr});
+      // Stage II for CCD, inside: on the triangles of the pairs Stage I leaves, records on the
+      // host, voxels and co-occupancy on the backend.
+      CcdOptions ccd_options{info.threads};
+      ccd_options.voxel_backend = voronoi.backend ? voronoi.ccd_backend.get() : nullptr;
+      ccd_options.voxel_grid = grid;
+      CcdStepResult c = continuous_collisions(frame, to, sweep, ccd_options);
       c.aabb_ms += sweep_ms;
-      c.voronoi_ms = voxel_ms;
-      if (voxels) {
-        c.voxel_grid = voxels->grid().dims;
-        c.voxel_cell = voxels->grid().cell;
-      }
       result.time_ms.aabb += c.aabb_ms;
       result.time_ms.voronoi += c.voronoi_ms;
       result.time_ms.exact += c.exact_ms;

@@ -191,11 +191,12 @@ struct CcdSkipped {
 
 struct CcdCounters {
   std::uint64_t object_pairs = 0;     ///< object pairs (i <= j) whose swept boxes overlap
-  /// Candidate triangle pairs after the box and Stage II per-triangle culling.
+  /// Candidate triangle pairs after the box culling (Stage I's BVH walk).
   std::uint64_t triangle_pairs = 0;
   /// Of those, pairs shown apart for the whole step along a separating axis (no tests ran).
   std::uint64_t separated_pairs = 0;
-  /// Of the rest, pairs that share no Stage II (slot, voxel) key (no tests ran).
+  /// Of the rest, pairs Stage II rules out (no tests ran): inter-object, one of the two
+  /// triangles has no (slot, voxel) key that another object marks; or the two share no key.
   std::uint64_t unshared_pairs = 0;
   /// Primitive pairs (vertex–face, edge–edge) shown apart for the whole step along a
   /// separating axis (no test ran).
@@ -203,7 +204,11 @@ struct CcdCounters {
   std::uint64_t vf_tests = 0;         ///< elementary vertex–face tests run
   std::uint64_t ee_tests = 0;         ///< elementary edge–edge tests run
   std::uint64_t limit_hits = 0;       ///< tests reported at the kernel's box limit
-  std::uint64_t culled_triangles = 0;  ///< triangles dropped by Stage II (inter-object)
+  /// Inter-object: (object pair, triangle of the first) whose candidate pairs Stage II drops
+  /// whole, the triangle having no key that another object marks.
+  std::uint64_t culled_triangles = 0;
+  /// Triangles Stage II voxelized (those of the pairs left after the separating-axis tests).
+  std::uint64_t voxelized_triangles = 0;
   std::uint64_t elementary_tests() const { return vf_tests + ee_tests; }
 };
 
@@ -217,6 +222,8 @@ struct CcdStepResult {
   std::vector<CcdEdgeEdge> ee;
   CcdCounters counters;
   double aabb_ms = 0, voronoi_ms = 0, exact_ms = 0;
+  /// Stage II was asked for (it runs only where Stage I leaves a pair to test).
+  bool stage2 = false;
   /// Stage II's space-time grid when it ran: voxels per axis and the cell's side.
   std::optional<std::array<std::int32_t, 3>> voxel_grid;
   double voxel_cell = 0;

@@ -586,6 +586,7 @@ struct Hdf5ResultWriter::Impl {
       write_attribute(g, ccd_where, "voronoi_grid_z", (*c.voxel_grid)[2]);
       write_attribute(g, ccd_where, "voronoi_cell", c.voxel_cell);
     }
+    if (c.stage2) write_attribute(g, ccd_where, "voxelized_triangles", std::uint64_t{k.voxelized_triangles});
     close_checked(ccd, "H5Gclose", ccd_where);
   }
 

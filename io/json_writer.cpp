@@ -98,6 +98,7 @@ Json ccd_stats_json(const CcdStepResult& c) {
   r["unshared_pairs"] = k.unshared_pairs;
   r["separated_primitives"] = k.separated_primitives;
   r["culled_triangles"] = k.culled_triangles;
+  if (c.stage2) r["voxelized_triangles"] = k.voxelized_triangles;
   r["limit_hits"] = k.limit_hits;
   r["vf_pairs"] = c.vf.size();
   r["ee_pairs"] = c.ee.size();

@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <map>
+#include <memory>
 #include <set>
 #include <tuple>
 #include <unordered_map>
@@ -371,6 +372,7 @@ void add(CcdCounters& a, const CcdCounters& b) {
   a.separated_pairs += b.separated_pairs;
   a.unshared_pairs += b.unshared_pairs;
   a.separated_primitives += b.separated_primitives;
+  a.voxelized_triangles += b.voxelized_triangles;
 }
 
 /// Sorts the hits canonically and summarises them per object pair.
@@ -709,9 +711,19 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
     for (Index t = 0; t < n; t += kChunk) tasks.push_back({i, j, p, t, std::min(n, t + kChunk)});
   }
   const Tester tester(from, to);
+  // Stage II runs on the triangle pairs that Stage I leaves: pairs not shown apart, with at
+  // least one primitive pair not shown apart. It is given by the caller, or built here over
+  // those pairs' triangles once Stage I has listed them: a reportable primitive pair is tested
+  // in its owner triangles' pair, which is then listed, so both triangles are voxelized and the
+  // culling argument of ccd_stage2.hpp holds for it. Without Stage II, each pair goes straight
+  // to its primitive tests.
   const CcdVoxelCulling* voxels = opts.voxels;
+  const bool stage2 = voxels || opts.voxel_backend;
+  std::vector<std::vector<std::pair<Index, Index>>> candidates(stage2 ? tasks.size() : 0);
   std::vector<Hits> parts(tasks.size());
-  parallel_for(tasks.size(), threads, [&](size_t k) {
+  // Stage I of task k (stage2: its candidate pairs are listed), or Stage III of its listed pairs
+  // after Stage II's checks (replay).
+  auto process = [&](size_t k, bool replay) {
     const Task& task = tasks[k];
     const Index i = task.i, j = task.j;
     const Object& oi = from.objects[static_cast<size_t>(i)];
@@ -751,36 +763,128 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
     // BVH subtree (EndBoxes), or the object pair's margin when smaller (both are valid; far
     // from the origin the rounding slack dominates, and each share carries its own).
     const double object_margin = sweep.pair_margin(i, j);
+    auto pair_margin = [&](Index f, Index g) {
+      return std::min(object_margin, ends_i.share[static_cast<size_t>(f)] + ends_j.share[static_cast<size_t>(g)]);
+    };
 
-    // Vertex v of object ov (owned by tri fv) against face g of object og.
-    auto vertex_face = [&](Index ov, const std::vector<AABB>& v_boxes, Index v, Index og, const Face& g_face, Index g,
+    // What the culling makes of a primitive pair: no test (boxes apart, or a vertex of the
+    // face itself), shown apart along a separating axis, or an elementary test to run.
+    enum class Cull { none, apart, test };
+    // Vertex v of object ov against face g of object og.
+    auto vertex_face = [&](Index ov, const std::vector<AABB>& v_boxes, Index v, const Face& g_face,
                            const AABB& g_raw, const SweptTriangle& g_swept, double margin) {
-      const double apart_gap = 2 * margin;
-      if (self && in_face(v, g_face)) return;
+      if (self && in_face(v, g_face)) return Cull::none;
       // The vertex's own swept box, widened by the pair's margin, against the face's.
       AABB vbox = v_boxes[static_cast<size_t>(v)];
       vbox.lo.array() -= margin;
       vbox.hi.array() += margin;
-      if (!boxes_overlap(vbox, g_raw)) return;
+      if (!boxes_overlap(vbox, g_raw)) return Cull::none;
       const SweptPrimitives<1, 3> p{{from.objects[static_cast<size_t>(ov)].positions[static_cast<size_t>(v)]},
                                     {to.objects[static_cast<size_t>(ov)].positions[static_cast<size_t>(v)]},
                                     g_swept.start, g_swept.end};
-      if (primitives_apart(p, {g_swept.normal, g_swept.normal_end}, apart_gap)) {
-        ++hits.counters.separated_primitives;
-        return;
-      }
-      tester.vertex_face(ov, v, og, g, hits);
+      return primitives_apart(p, {g_swept.normal, g_swept.normal_end}, 2 * margin) ? Cull::apart : Cull::test;
     };
+
+    // Stage III of a candidate pair: the culling of its primitive pairs, then their elementary
+    // tests. With `probe`, no test runs: true as soon as one primitive pair would be tested (its
+    // separated primitives are then left uncounted, for the run that tests them to count).
+    auto test_pair = [&](Index f, Index g, bool probe) {
+      const double margin = pair_margin(f, g);
+      const Face& ff = oi.topology->faces[static_cast<size_t>(f)];
+      const Face& gf = oj.topology->faces[static_cast<size_t>(g)];
+      const AABB f_raw = raw_box(vb_i, ff);
+      const AABB g_raw = raw_box(vb_j, gf);
+      const SweptTriangle& swept_f = swept_i[static_cast<size_t>(f)];
+      const SweptTriangle& swept_g = swept_j[static_cast<size_t>(g)];
+      std::uint64_t apart = 0;
+      bool tested = false;
+      for (size_t c = 0; c < 3; ++c) {
+        if (own_i.vertex[static_cast<size_t>(ff[c])] != f || repeats_earlier(ff, c)) continue;
+        const Cull r = vertex_face(i, vb_i, ff[c], gf, g_raw, swept_g, margin);
+        if (r == Cull::apart) ++apart;
+        if (r != Cull::test) continue;
+        if (probe) return true;
+        tested = true;
+        tester.vertex_face(i, ff[c], j, g, hits);
+      }
+      for (size_t c = 0; c < 3; ++c) {
+        if (own_j.vertex[static_cast<size_t>(gf[c])] != g || repeats_earlier(gf, c)) continue;
+        const Cull r = vertex_face(j, vb_j, gf[c], ff, f_raw, swept_f, margin);
+        if (r == Cull::apart) ++apart;
+        if (r != Cull::test) continue;
+        if (probe) return true;
+        tested = true;
+        tester.vertex_face(j, gf[c], i, f, hits);
+      }
+      const auto& fe = adj_i.triangle_edges(f);
+      const auto& ge = adj_j.triangle_edges(g);
+      for (size_t ka = 0; ka < 3; ++ka) {
+        const Index ea = fe[ka];
+        if (ea == kNoIndex || own_i.edge[static_cast<size_t>(ea)] != f || repeats_earlier(fe, ka)) continue;
+        const auto& va = adj_i.edges()[static_cast<size_t>(ea)];
+        const AABB ba = edge_box(vb_i, va);
+        for (size_t kb = 0; kb < 3; ++kb) {
+          const Index eb = ge[kb];
+          if (eb == kNoIndex || own_j.edge[static_cast<size_t>(eb)] != g || repeats_earlier(ge, kb)) continue;
+          const auto& vb = adj_j.edges()[static_cast<size_t>(eb)];
+          if (self && share_endpoint(va, vb)) continue;
+          AABB bb = edge_box(vb_j, vb);
+          bb.lo.array() -= margin;
+          bb.hi.array() += margin;
+          if (!boxes_overlap(ba, bb)) continue;
+          auto ends = [](const Object& o, const std::array<Index, 2>& e) {
+            return std::array<Vec3, 2>{o.positions[static_cast<size_t>(e[0])], o.positions[static_cast<size_t>(e[1])]};
+          };
+          const SweptPrimitives<2, 2> p{ends(oi, va), ends(ti, va), ends(oj, vb), ends(tj, vb)};
+          const Vec3 cross_start = (p.a_start[1] - p.a_start[0]).cross(p.b_start[1] - p.b_start[0]);
+          const Vec3 cross_end = (p.a_end[1] - p.a_end[0]).cross(p.b_end[1] - p.b_end[0]);
+          if (primitives_apart(p, {cross_start, cross_end}, 2 * margin)) {
+            ++apart;
+            continue;
+          }
+          if (probe) return true;
+          tested = true;
+          // Canonical order: the smaller (object, edge id) first.
+          if (i < j || (self && ea < eb))
+            tester.edge_edge(i, va, j, vb, hits);
+          else
+            tester.edge_edge(j, vb, i, va, hits);
+        }
+      }
+      hits.counters.separated_primitives += apart;
+      return tested;
+    };
+
+    if (replay) {
+      // Stage II's checks, then Stage III. Inter-object: a triangle none of whose keys another
+      // object marks takes part in no collision (counted once per triangle and task, the
+      // pairs of its run all dropped); then the pair must share a key.
+      Index last_f = kNoIndex;
+      bool f_kept = true;
+      for (const auto& [f, g] : candidates[k]) {
+        if (!self) {
+          if (f != last_f) {
+            last_f = f;
+            f_kept = voxels->keeps(i, f);
+            if (!f_kept) ++hits.counters.culled_triangles;
+          }
+          if (!f_kept || !voxels->keeps(j, g)) {
+            ++hits.counters.unshared_pairs;
+            continue;
+          }
+        }
+        if (!voxels->share_voxel(i, f, j, g)) {
+          ++hits.counters.unshared_pairs;
+          continue;
+        }
+        test_pair(f, g, false);
+      }
+      return;
+    }
 
     for (Index q = task.first; q < task.last; ++q) {
       const Index f = self ? q : near[task.pair][static_cast<size_t>(q)];
       const AABB& fb = tb_i[static_cast<size_t>(f)];
-      if (voxels && !self && !voxels->keeps(i, f)) {
-        ++hits.counters.culled_triangles;
-        continue;
-      }
-      const Face& ff = oi.topology->faces[static_cast<size_t>(f)];
-      const AABB f_raw = raw_box(vb_i, ff);
       const SweptTriangle& swept_f = swept_i[static_cast<size_t>(f)];
       const AABB& f_start = ends_i.start[static_cast<size_t>(f)];
       const AABB& f_end = ends_i.end[static_cast<size_t>(f)];
@@ -806,69 +910,54 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
         if (self && g <= f) return;  // each unordered pair once
         if (self && TriangleBvh::adjacent_subtree(pivot[static_cast<size_t>(j)][static_cast<size_t>(g)], f_pivots))
           return;  // a common pivot: no primitive pair to test
-        if (voxels && (!self && !voxels->keeps(j, g))) return;
         ++hits.counters.triangle_pairs;
-        const Face& gf = oj.topology->faces[static_cast<size_t>(g)];
-        const double margin = std::min(object_margin, f_share + ends_j.share[static_cast<size_t>(g)]);
-        const double apart_gap = 2 * margin;
+        const double apart_gap = 2 * pair_margin(f, g);
         if (apart_at_both_ends(f_start, f_end, ends_j.start[static_cast<size_t>(g)], ends_j.end[static_cast<size_t>(g)],
                                apart_gap) ||
             swept_apart(swept_f, swept_j[static_cast<size_t>(g)], apart_gap)) {
           ++hits.counters.separated_pairs;
           return;
         }
-        // After the separation tests, which are cheaper than merging two key lists and leave
-        // few pairs to it.
-        if (voxels && !voxels->share_voxel(i, f, j, g)) {
-          ++hits.counters.unshared_pairs;
-          return;
-        }
-        const AABB g_raw = raw_box(vb_j, gf);
-        const SweptTriangle& swept_g = swept_j[static_cast<size_t>(g)];
-        for (size_t k = 0; k < 3; ++k)
-          if (own_i.vertex[static_cast<size_t>(ff[k])] == f && !repeats_earlier(ff, k))
-            vertex_face(i, vb_i, ff[k], j, gf, g, g_raw, swept_g, margin);
-        for (size_t k = 0; k < 3; ++k)
-          if (own_j.vertex[static_cast<size_t>(gf[k])] == g && !repeats_earlier(gf, k))
-            vertex_face(j, vb_j, gf[k], i, ff, f, f_raw, swept_f, margin);
-        const auto& fe = adj_i.triangle_edges(f);
-        const auto& ge = adj_j.triangle_edges(g);
-        for (size_t ka = 0; ka < 3; ++ka) {
-          const Index ea = fe[ka];
-          if (ea == kNoIndex || own_i.edge[static_cast<size_t>(ea)] != f || repeats_earlier(fe, ka)) continue;
-          const auto& va = adj_i.edges()[static_cast<size_t>(ea)];
-          const AABB ba = edge_box(vb_i, va);
-          for (size_t kb = 0; kb < 3; ++kb) {
-            const Index eb = ge[kb];
-            if (eb == kNoIndex || own_j.edge[static_cast<size_t>(eb)] != g || repeats_earlier(ge, kb)) continue;
-            const auto& vb = adj_j.edges()[static_cast<size_t>(eb)];
-            if (self && share_endpoint(va, vb)) continue;
-            AABB bb = edge_box(vb_j, vb);
-            bb.lo.array() -= margin;
-            bb.hi.array() += margin;
-            if (!boxes_overlap(ba, bb)) continue;
-            auto ends = [](const Object& o, const std::array<Index, 2>& e) {
-              return std::array<Vec3, 2>{o.positions[static_cast<size_t>(e[0])], o.positions[static_cast<size_t>(e[1])]};
-            };
-            const SweptPrimitives<2, 2> p{ends(oi, va), ends(ti, va), ends(oj, vb), ends(tj, vb)};
-            const Vec3 cross_start = (p.a_start[1] - p.a_start[0]).cross(p.b_start[1] - p.b_start[0]);
-            const Vec3 cross_end = (p.a_end[1] - p.a_end[0]).cross(p.b_end[1] - p.b_end[0]);
-            if (primitives_apart(p, {cross_start, cross_end}, apart_gap)) {
-              ++hits.counters.separated_primitives;
-              continue;
-            }
-            // Canonical order: the smaller (object, edge id) first.
-            if (i < j || (self && ea < eb))
-              tester.edge_edge(i, va, j, vb, hits);
-            else
-              tester.edge_edge(j, vb, i, va, hits);
-          }
-        }
+        // With Stage II, the pairs with a primitive pair to test are listed for it (the pairs
+        // whose primitive pairs are all culled here need no voxels), and tested after it.
+        if (!stage2)
+          test_pair(f, g, false);
+        else if (test_pair(f, g, true))
+          candidates[k].emplace_back(f, g);
       });
     }
-  });
+  };
+  parallel_for(tasks.size(), threads, [&](size_t k) { process(k, false); });
+  if (stage2) {
+    // Stage II over the triangles of the listed pairs, unless the caller built it.
+    std::unique_ptr<CcdVoxelCulling> built;
+    out.stage2 = true;
+    bool any = false;
+    for (const auto& c : candidates) any = any || !c.empty();
+    if (!voxels && any) {
+      const double stage1_ms = sw.elapsed_ms();
+      Stopwatch stage2_sw;
+      CcdTriangleMask used(from.objects.size());
+      for (Index i : live) used[static_cast<size_t>(i)].assign(static_cast<size_t>(from.objects[static_cast<size_t>(i)].num_triangles()), 0);
+      for (size_t k = 0; k < tasks.size(); ++k)
+        for (const auto& [f, g] : candidates[k]) {
+          used[static_cast<size_t>(tasks[k].i)][static_cast<size_t>(f)] = 1;
+          used[static_cast<size_t>(tasks[k].j)][static_cast<size_t>(g)] = 1;
+        }
+      built = std::make_unique<CcdVoxelCulling>(from, to, sweep, CcdVoxelOptions{opts.voxel_grid, opts.voxel_slots, threads},
+                                                *opts.voxel_backend, &used);
+      voxels = built.get();
+      out.voronoi_ms = stage2_sw.elapsed_ms();
+      out.voxel_grid = voxels->grid().dims;
+      out.voxel_cell = voxels->grid().cell;
+      out.counters.voxelized_triangles = voxels->voxelized_triangles();
+      sw.restart();
+      out.exact_ms = stage1_ms;
+    }
+    if (any) parallel_for(tasks.size(), threads, [&](size_t k) { process(k, true); });
+  }
   finish(parts, out);
-  out.exact_ms = sw.elapsed_ms();
+  out.exact_ms += sw.elapsed_ms();
   return out;
 }
 

@@ -14,7 +14,9 @@
 // separating axis shows apart by more than twice the margin at both ends of the step (hence
 // throughout it: ccd.cpp) is skipped, and so is each primitive pair of the remaining triangle
 // pairs that the same argument shows apart (CcdCounters::separated_primitives). Optional Stage II
-// (core/voronoi/ccd_stage2.hpp) culls them further with a voxelization of the swept prisms.
+// (core/voronoi/ccd_stage2.hpp) culls the triangle pairs left after the separating-axis tests
+// (of the pairs and of their primitives) with a voxelization of the swept prisms: of those
+// pairs' triangles only, when built here.
 // Stage III: the elementary tests of core/geometry/ccd.hpp, each vertex–face and edge–edge pair
 // tested once (see ccd.cpp for the ownership rule that deduplicates without a global set).
 //
@@ -44,12 +46,20 @@
 namespace vproxq {
 
 class CcdVoxelCulling;
+class CcdVoxelBackend;
 
 struct CcdOptions {
   int threads = 1;
-  /// Stage II: culling by a conservative voxelization of the swept triangles, or null.
-  /// Built by the caller for this step (ccd_stage2.hpp); it never changes the answer.
+  /// Stage II: culling by a conservative voxelization of the swept triangles, built by the
+  /// caller for this step (ccd_stage2.hpp), or null. It never changes the answer.
   const CcdVoxelCulling* voxels = nullptr;
+  /// Or, when `voxels` is null, Stage II built here with this backend after Stage I, over the
+  /// triangles of the candidate pairs Stage I leaves (not shown apart, and with a primitive
+  /// pair not shown apart: the only pairs whose keys are ever looked at); the result's
+  /// voronoi_ms, voxel_grid, voxel_cell and counters.voxelized_triangles describe it.
+  CcdVoxelBackend* voxel_backend = nullptr;
+  int voxel_grid = 0;   ///< its CcdVoxelOptions::grid_resolution (0: automatic)
+  int voxel_slots = 0;  ///< its CcdVoxelOptions::slots (0: default)
 };
 
 /// The objects of `from` that take part in the step, with the reason for each one left out.

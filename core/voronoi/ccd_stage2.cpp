@@ -197,7 +197,8 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
                       *make_cpu_ccd_voxel_backend(threads)) {}
 
 CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSweep& sweep,
-                                 const CcdVoxelOptions& options, CcdVoxelBackend& backend) {
+                                 const CcdVoxelOptions& options, CcdVoxelBackend& backend,
+                                 const CcdTriangleMask* only) {
   Stopwatch sw;
   const int threads = std::max(1, options.threads);
   slots_ = options.slots > 0 ? options.slots : CcdVoxelOptions::kDefaultSlots;
@@ -207,23 +208,42 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
   first_.assign(n + 1, 0);
   std::vector<std::uint8_t> part(n, 0);
   for (Index i : sweep.participants.objects) part[static_cast<size_t>(i)] = 1;
+  for (size_t i = 0; i < n; ++i) first_[i + 1] = first_[i] + (part[i] ? from.objects[i].num_triangles() : 0);
+  const std::int64_t total_tris = first_[n];
+  offsets_.assign(1, 0);
+  // A triangle without records (left out by `only`) is never ruled out (keeps(), share_voxel()).
+  foreign_.assign(static_cast<size_t>(total_tris), 1);
+  record_of_.assign(static_cast<size_t>(total_tris), -1);
+  // The voxelized triangles (global ids, ascending, so each object's are consecutive: object
+  // i's are tris[qfirst[i] .. qfirst[i + 1])), and the scene box: every one's swept box
+  // widened by the step's margin (the prisms below), and by its own share (its box in the
+  // sweep). The grid covers them all.
+  std::vector<std::int64_t> tris;
+  std::vector<std::int64_t> qfirst(n + 1, 0);
   AABB scene;
   for (size_t i = 0; i < n; ++i) {
-    first_[i + 1] = first_[i] + (part[i] ? from.objects[i].num_triangles() : 0);
-    if (part[i] && !sweep.objects[i].empty()) {
-      // The object's triangle boxes are widened by their own shares of the margin; the
-      // prisms below by the step's whole margin: the grid covers both.
-      AABB box = sweep.raw_objects[i];
+    qfirst[i] = static_cast<std::int64_t>(tris.size());
+    if (!part[i] || sweep.objects[i].empty()) continue;
+    const std::vector<std::uint8_t>* mask = only ? &(*only)[i] : nullptr;
+    const Object& o = from.objects[i];
+    for (Index t = 0; t < o.num_triangles(); ++t) {
+      if (mask && (static_cast<size_t>(t) >= mask->size() || !(*mask)[static_cast<size_t>(t)])) continue;
+      const std::int64_t g = first_[i] + t;
+      record_of_[static_cast<size_t>(g)] = static_cast<std::int64_t>(tris.size());
+      tris.push_back(g);
+      const Face& f = o.topology->faces[static_cast<size_t>(t)];
+      AABB box;
+      for (Index v : f) box.extend(sweep.vertices[i][static_cast<size_t>(v)]);
       box.lo.array() -= sweep.margin;
       box.hi.array() += sweep.margin;
-      box.extend(sweep.objects[i]);
+      box.extend(sweep.triangles[i][static_cast<size_t>(t)]);
       scene.extend(box);
     }
   }
-  const std::int64_t total_tris = first_[n];
-  offsets_.assign(1, 0);
-  foreign_.assign(static_cast<size_t>(total_tris), 0);
-  if (scene.empty() || total_tris == 0) return;
+  qfirst[n] = static_cast<std::int64_t>(tris.size());
+  const std::int64_t used = static_cast<std::int64_t>(tris.size());
+  voxelized_ = static_cast<std::uint64_t>(used);
+  if (scene.empty() || used == 0) return;
   const Vec3 ext = scene.hi - scene.lo;
   const double longest = std::max(ext.maxCoeff(), 1e-300);
   const double K = slots_;
@@ -243,10 +263,11 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
   // step): coarser cells cannot separate neighbours, finer ones multiply the marks.
   double cell;
   {
-    std::vector<double> size(static_cast<size_t>(total_tris));
-    parallel_for((static_cast<size_t>(total_tris) + kChunk - 1) / kChunk, threads, [&](size_t c) {
-      const std::int64_t end = std::min<std::int64_t>(total_tris, static_cast<std::int64_t>((c + 1) * kChunk));
-      for (std::int64_t t = static_cast<std::int64_t>(c * kChunk); t < end; ++t) {
+    std::vector<double> size(static_cast<size_t>(used));
+    parallel_for((static_cast<size_t>(used) + kChunk - 1) / kChunk, threads, [&](size_t c) {
+      const std::int64_t end = std::min<std::int64_t>(used, static_cast<std::int64_t>((c + 1) * kChunk));
+      for (std::int64_t q = static_cast<std::int64_t>(c * kChunk); q < end; ++q) {
+        const std::int64_t t = tris[static_cast<size_t>(q)];
         AABB b0, b1;
         Vec3 motion = Vec3::Zero();
         for (int k = 0; k < 3; ++k) {
@@ -254,7 +275,7 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
           b1.extend(corner(t, k, true));
           motion = motion.cwiseMax((corner(t, k, true) - corner(t, k, false)).cwiseAbs());
         }
-        size[static_cast<size_t>(t)] = ((b0.hi - b0.lo).cwiseMax(b1.hi - b1.lo) + motion / K).maxCoeff();
+        size[static_cast<size_t>(q)] = ((b0.hi - b0.lo).cwiseMax(b1.hi - b1.lo) + motion / K).maxCoeff();
       }
     });
     if (options.grid_resolution > 0) {
@@ -300,13 +321,14 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
   // concatenation of its records' (ascending: the slot is the most significant part).
   CcdVoxelInput in;
   in.dims = grid_.dims;
-  const size_t nrec = static_cast<size_t>(total_tris) * static_cast<size_t>(slots_);
+  const size_t nrec = static_cast<size_t>(used) * static_cast<size_t>(slots_);
   in.records.resize(nrec);
   std::vector<std::uint64_t> room(nrec);
   const std::uint32_t per_slot = static_cast<std::uint32_t>(grid_.voxel_count());
-  parallel_for((static_cast<size_t>(total_tris) + kChunk - 1) / kChunk, threads, [&](size_t c) {
-    const std::int64_t end = std::min<std::int64_t>(total_tris, static_cast<std::int64_t>((c + 1) * kChunk));
-    for (std::int64_t t = static_cast<std::int64_t>(c * kChunk); t < end; ++t) {
+  parallel_for((static_cast<size_t>(used) + kChunk - 1) / kChunk, threads, [&](size_t c) {
+    const std::int64_t end = std::min<std::int64_t>(used, static_cast<std::int64_t>((c + 1) * kChunk));
+    for (std::int64_t q = static_cast<std::int64_t>(c * kChunk); q < end; ++q) {
+      const std::int64_t t = tris[static_cast<size_t>(q)];
       std::array<Vec3, 3> u0, u1;
       for (int k = 0; k < 3; ++k) {
         u0[static_cast<size_t>(k)] = (corner(t, k, false) - grid_.origin) / cell;
@@ -322,7 +344,7 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
           p[k + 3] = u0[k] + tb * d;
           pm[k] = u0[k] + tm * d;
         }
-        CcdVoxelRecord& r = in.records[static_cast<size_t>(t) * static_cast<size_t>(slots_) + static_cast<size_t>(s)];
+        CcdVoxelRecord& r = in.records[static_cast<size_t>(q) * static_cast<size_t>(slots_) + static_cast<size_t>(s)];
         r.key_base = static_cast<std::uint32_t>(s) * per_slot;
         r.pad[0] = r.pad[1] = 0;
         std::uint64_t volume = 1;
@@ -371,12 +393,12 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
           r.below[a] = clamp_threshold(std::ceil(lo - widen - pos) - 1);
           r.above[a] = clamp_threshold(std::floor(hi + widen + neg) + 1);
         }
-        room[static_cast<size_t>(t) * static_cast<size_t>(slots_) + static_cast<size_t>(s)] = volume;
+        room[static_cast<size_t>(q) * static_cast<size_t>(slots_) + static_cast<size_t>(s)] = volume;
       }
     }
   });
   in.record_object.resize(nrec);
-  for (size_t r = 0; r < nrec; ++r) in.record_object[r] = tri_object[r / static_cast<size_t>(slots_)];
+  for (size_t r = 0; r < nrec; ++r) in.record_object[r] = tri_object[static_cast<size_t>(tris[r / static_cast<size_t>(slots_)])];
   in.key_count = static_cast<std::uint32_t>(grid_.voxel_count() * slots_);
   in.cooccupancy = in.key_count <= kCcdMaxDenseKeys;
   in.out_offsets.assign(nrec + 1, 0);
@@ -407,18 +429,20 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
   timings_.compact_ms = sw.elapsed_ms();
   sw.restart();
 
+  for (std::int64_t t : tris) foreign_[static_cast<size_t>(t)] = 0;
   if (in.cooccupancy) {
-    for (std::int64_t t = 0; t < total_tris; ++t)
-      for (int s = 0; s < slots_; ++s) foreign_[static_cast<size_t>(t)] |= out.foreign[static_cast<size_t>(t * slots_ + s)] != 0;
+    for (std::int64_t q = 0; q < used; ++q)
+      for (int s = 0; s < slots_; ++s)
+        foreign_[static_cast<size_t>(tris[static_cast<size_t>(q)])] |= out.foreign[static_cast<size_t>(q * slots_ + s)] != 0;
   } else {
     // Too many keys for a dense table: each object's distinct keys, all of them together
     // radix-sorted; a key listed twice is shared. The same answer as the table.
     std::vector<std::vector<std::uint32_t>> distinct(n);
     parallel_for(n, threads, [&](size_t i) {
-      if (first_[i] == first_[i + 1]) return;
+      if (qfirst[i] == qfirst[i + 1]) return;
       auto& d = distinct[i];
-      d.assign(keys_.begin() + static_cast<std::ptrdiff_t>(offsets_[static_cast<size_t>(first_[i] * slots_)]),
-               keys_.begin() + static_cast<std::ptrdiff_t>(offsets_[static_cast<size_t>(first_[i + 1] * slots_)]));
+      d.assign(keys_.begin() + static_cast<std::ptrdiff_t>(offsets_[static_cast<size_t>(qfirst[i] * slots_)]),
+               keys_.begin() + static_cast<std::ptrdiff_t>(offsets_[static_cast<size_t>(qfirst[i + 1] * slots_)]));
       std::sort(d.begin(), d.end());
       d.erase(std::unique(d.begin(), d.end()), d.end());
     });
@@ -428,12 +452,12 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
     std::vector<std::uint32_t> shared;
     for (size_t k = 1; k < all.size(); ++k)
       if (all[k] == all[k - 1] && (shared.empty() || shared.back() != all[k])) shared.push_back(all[k]);
-    parallel_for((static_cast<size_t>(total_tris) + kChunk - 1) / kChunk, threads, [&](size_t c) {
-      const std::int64_t end = std::min<std::int64_t>(total_tris, static_cast<std::int64_t>((c + 1) * kChunk));
-      for (std::int64_t t = static_cast<std::int64_t>(c * kChunk); t < end; ++t)
-        for (std::uint64_t k = offsets_[static_cast<size_t>(t * slots_)]; k < offsets_[static_cast<size_t>((t + 1) * slots_)]; ++k)
+    parallel_for((static_cast<size_t>(used) + kChunk - 1) / kChunk, threads, [&](size_t c) {
+      const std::int64_t end = std::min<std::int64_t>(used, static_cast<std::int64_t>((c + 1) * kChunk));
+      for (std::int64_t q = static_cast<std::int64_t>(c * kChunk); q < end; ++q)
+        for (std::uint64_t k = offsets_[static_cast<size_t>(q * slots_)]; k < offsets_[static_cast<size_t>((q + 1) * slots_)]; ++k)
           if (std::binary_search(shared.begin(), shared.end(), keys_[static_cast<size_t>(k)])) {
-            foreign_[static_cast<size_t>(t)] = 1;
+            foreign_[static_cast<size_t>(tris[static_cast<size_t>(q)])] = 1;
             break;
           }
     });
@@ -442,8 +466,11 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
 }
 
 bool CcdVoxelCulling::share_voxel(Index i, Index f, Index j, Index g) const {
-  const size_t ra = static_cast<size_t>((first_[static_cast<size_t>(i)] + f) * slots_);
-  const size_t rb = static_cast<size_t>((first_[static_cast<size_t>(j)] + g) * slots_);
+  const std::int64_t qa = record_of_[static_cast<size_t>(first_[static_cast<size_t>(i)] + f)];
+  const std::int64_t qb = record_of_[static_cast<size_t>(first_[static_cast<size_t>(j)] + g)];
+  if (qa < 0 || qb < 0) return true;  // not voxelized: nothing rules the pair out
+  const size_t ra = static_cast<size_t>(qa * slots_);
+  const size_t rb = static_cast<size_t>(qb * slots_);
   for (size_t s = 0; s < static_cast<size_t>(slots_); ++s) {
     const auto& ba = boxes_[ra + s];
     const auto& bb = boxes_[rb + s];
@@ -464,7 +491,9 @@ bool CcdVoxelCulling::share_voxel(Index i, Index f, Index j, Index g) const {
 }
 
 std::vector<std::uint32_t> CcdVoxelCulling::keys(Index object, Index triangle) const {
-  const size_t r = static_cast<size_t>((first_[static_cast<size_t>(object)] + triangle) * slots_);
+  const std::int64_t q = record_of_[static_cast<size_t>(first_[static_cast<size_t>(object)] + triangle)];
+  if (q < 0) return {};
+  const size_t r = static_cast<size_t>(q * slots_);
   return {keys_.begin() + static_cast<std::ptrdiff_t>(offsets_[r]),
           keys_.begin() + static_cast<std::ptrdiff_t>(offsets_[r + static_cast<size_t>(slots_)])};
 }

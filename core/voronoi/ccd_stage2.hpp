@@ -104,11 +104,19 @@ struct CcdVoxelTimings {
   double cooccupancy_ms = 0;  ///< keys marked by two objects, per-triangle inter-object flags
 };
 
+/// Per object, per triangle: 1 to take part (objects or triangles past the end: 0).
+using CcdTriangleMask = std::vector<std::vector<std::uint8_t>>;
+
 class CcdVoxelCulling {
  public:
-  /// Voxelizes every participating triangle of the step with `backend`.
+  /// Voxelizes the participating triangles of the step with `backend`: all of them, or with
+  /// `only` those it marks. A triangle left out has no keys and is never ruled out (keeps()
+  /// and share_voxel() are true for it), so the culling stays valid for every pair; leaving
+  /// out triangles that take part in no candidate pair only saves work. The grid covers the
+  /// voxelized triangles, and its default cell follows their sizes.
   CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSweep& sweep,
-                  const CcdVoxelOptions& options, CcdVoxelBackend& backend);
+                  const CcdVoxelOptions& options, CcdVoxelBackend& backend,
+                  const CcdTriangleMask* only = nullptr);
   /// The same with the CPU backend, default slots.
   CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSweep& sweep, int grid_resolution,
                   int threads);
@@ -127,6 +135,7 @@ class CcdVoxelCulling {
   const VoronoiGrid& grid() const { return grid_; }
   int slots() const { return slots_; }
   std::uint64_t marked_voxels() const { return keys_.size(); }  ///< (triangle, key) marks
+  std::uint64_t voxelized_triangles() const { return voxelized_; }
   const CcdVoxelTimings& timings() const { return timings_; }
 
  private:
@@ -135,6 +144,10 @@ class CcdVoxelCulling {
   CcdVoxelTimings timings_;
   /// Triangles of all objects numbered consecutively: object i's start at first_[i].
   std::vector<std::int64_t> first_;
+  /// Per triangle (numbered as above): its index among the voxelized triangles, whose records
+  /// are q * slots .. q * slots + slots - 1; -1 when it was left out.
+  std::vector<std::int64_t> record_of_;
+  std::uint64_t voxelized_ = 0;
   /// CSR per record (triangle-major, then slot): keys_[offsets_[r] .. offsets_[r + 1]),
   /// ascending; a triangle's records are consecutive, so its keys are too.
   std::vector<std::uint64_t> offsets_;

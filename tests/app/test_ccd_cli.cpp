@@ -138,7 +138,8 @@ TEST(CcdCli, BackendsGiveIdenticalResultsEqualToBruteForce) {
       if (!cpu["frames"][f]["stats"].contains("ccd")) continue;
       const auto& c = cpu["frames"][f]["stats"]["ccd"];
       const auto& g = gpu["frames"][f]["stats"]["ccd"];
-      for (const char* key : {"elementary_tests", "triangle_pairs", "unshared_pairs", "culled_triangles", "object_pairs"})
+      for (const char* key : {"elementary_tests", "triangle_pairs", "unshared_pairs", "culled_triangles", "object_pairs",
+                              "voxelized_triangles"})
         EXPECT_EQ(c[key].get<std::uint64_t>(), g[key].get<std::uint64_t>()) << "frame " << f << " " << key;
       // The grid Stage II used is recorded (cells of 1/24 of the swept box's longest side, plus
       // the boundary cell); without Stage II there is none.
@@ -147,6 +148,8 @@ TEST(CcdCli, BackendsGiveIdenticalResultsEqualToBruteForce) {
       EXPECT_EQ(std::max({c["grid"][0].get<int>(), c["grid"][1].get<int>(), c["grid"][2].get<int>()}), 25);
       EXPECT_GT(c["cell"].get<double>(), 0.0);
       EXPECT_FALSE(off["frames"][f]["stats"]["ccd"].contains("grid"));
+      EXPECT_FALSE(off["frames"][f]["stats"]["ccd"].contains("voxelized_triangles"));
+      EXPECT_GT(c["voxelized_triangles"].get<std::uint64_t>(), 0u);
       tests_cpu += c["elementary_tests"].get<std::uint64_t>();
       tests_off += off["frames"][f]["stats"]["ccd"]["elementary_tests"].get<std::uint64_t>();
     }

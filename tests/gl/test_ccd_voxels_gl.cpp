@@ -10,6 +10,7 @@
 #include "gl/ccd_voxel_backend.hpp"
 #include "gl_test_support.hpp"
 #include "support/ccd_voxels.hpp"
+#include "support/expect_same.hpp"
 #include "support/random_scene.hpp"
 
 namespace vproxq::gl {
@@ -113,6 +114,44 @@ TEST(CcdVoxelsGl, PipelineCullingEqualsTheCpuBackend) {
       for (size_t k = 0; k < ref.ee.size(); ++k) EXPECT_EQ(rb.ee[k].toi, ref.ee[k].toi);
     }
   }
+}
+
+// Stage II built inside continuous_collisions() over the candidate pairs' triangles: the GL
+// backend gives the CPU's culling, counter for counter, and the brute force's answers.
+TEST(CcdVoxelsGl, StageIIOverTheCandidatePairsEqualsTheCpuBackend) {
+  VPROXQ_GL_CONTEXT_OR_FAIL(context);
+  GlCcdVoxelBackend gpu(context);
+  const auto cpu = make_cpu_ccd_voxel_backend(2);
+  std::uint64_t unshared = 0;
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const Frame from = test::make_random_frame(seed + 40, 5, 3.0, 1);
+    const Frame to = test::moved(from, seed * 7, 0.8, seed % 2 ? 0.25 : 0.05);
+    const CcdSweep sweep = CcdSweep::compute(from, to, 2);
+    const CcdStepResult ref = continuous_collisions_brute_force(from, to);
+    for (int slots : {2, 8}) {
+      for (int grid : {0, 50}) {
+        SCOPED_TRACE("slots " + std::to_string(slots) + " grid " + std::to_string(grid));
+        CcdOptions a{2}, b{2};
+        a.voxel_backend = cpu.get();
+        b.voxel_backend = &gpu;
+        a.voxel_grid = b.voxel_grid = grid;
+        a.voxel_slots = b.voxel_slots = slots;
+        const CcdStepResult ra = continuous_collisions(from, to, sweep, a);
+        const CcdStepResult rb = continuous_collisions(from, to, sweep, b);
+        ASSERT_TRUE(ra.voxel_grid && rb.voxel_grid);
+        EXPECT_EQ(*ra.voxel_grid, *rb.voxel_grid);
+        EXPECT_EQ(ra.counters.voxelized_triangles, rb.counters.voxelized_triangles);
+        EXPECT_GT(ra.counters.voxelized_triangles, 0u);
+        EXPECT_EQ(ra.counters.unshared_pairs, rb.counters.unshared_pairs);
+        EXPECT_EQ(ra.counters.culled_triangles, rb.counters.culled_triangles);
+        EXPECT_EQ(ra.counters.elementary_tests(), rb.counters.elementary_tests());
+        unshared += ra.counters.unshared_pairs;
+        test::expect_same_ccd(rb, ref);
+      }
+    }
+  }
+  EXPECT_GT(unshared, 0u);  // the culling runs, or the comparison proves little
 }
 
 }  // namespace
