@@ -719,7 +719,11 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
   // to its primitive tests.
   const CcdVoxelCulling* voxels = opts.voxels;
   const bool stage2 = voxels || opts.voxel_backend;
-  std::vector<std::vector<std::pair<Index, Index>>> candidates(stage2 ? tasks.size() : 0);
+  struct Candidate {
+    Index f, g;
+    std::uint16_t mask;  ///< its primitive pairs to test (cull_pair())
+  };
+  std::vector<std::vector<Candidate>> candidates(stage2 ? tasks.size() : 0);
   std::vector<Hits> parts(tasks.size());
   // Stage I of task k (stage2: its candidate pairs are listed), or Stage III of its listed pairs
   // after Stage II's checks (replay).
@@ -785,10 +789,10 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
       return primitives_apart(p, {g_swept.normal, g_swept.normal_end}, 2 * margin) ? Cull::apart : Cull::test;
     };
 
-    // Stage III of a candidate pair: the culling of its primitive pairs, then their elementary
-    // tests. With `probe`, no test runs: true as soon as one primitive pair would be tested (its
-    // separated primitives are then left uncounted, for the run that tests them to count).
-    auto test_pair = [&](Index f, Index g, bool probe) {
+    // The primitive pairs of a candidate triangle pair that the culling leaves, as a mask:
+    // bits 0-2 f's owned vertices against g, 3-5 g's against f, 6 + 3 ka + kb f's owned edge ka
+    // against g's kb. Counts the pairs it shows apart.
+    auto cull_pair = [&](Index f, Index g) {
       const double margin = pair_margin(f, g);
       const Face& ff = oi.topology->faces[static_cast<size_t>(f)];
       const Face& gf = oj.topology->faces[static_cast<size_t>(g)];
@@ -796,26 +800,17 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
       const AABB g_raw = raw_box(vb_j, gf);
       const SweptTriangle& swept_f = swept_i[static_cast<size_t>(f)];
       const SweptTriangle& swept_g = swept_j[static_cast<size_t>(g)];
-      std::uint64_t apart = 0;
-      bool tested = false;
-      for (size_t c = 0; c < 3; ++c) {
-        if (own_i.vertex[static_cast<size_t>(ff[c])] != f || repeats_earlier(ff, c)) continue;
-        const Cull r = vertex_face(i, vb_i, ff[c], gf, g_raw, swept_g, margin);
-        if (r == Cull::apart) ++apart;
-        if (r != Cull::test) continue;
-        if (probe) return true;
-        tested = true;
-        tester.vertex_face(i, ff[c], j, g, hits);
-      }
-      for (size_t c = 0; c < 3; ++c) {
-        if (own_j.vertex[static_cast<size_t>(gf[c])] != g || repeats_earlier(gf, c)) continue;
-        const Cull r = vertex_face(j, vb_j, gf[c], ff, f_raw, swept_f, margin);
-        if (r == Cull::apart) ++apart;
-        if (r != Cull::test) continue;
-        if (probe) return true;
-        tested = true;
-        tester.vertex_face(j, gf[c], i, f, hits);
-      }
+      std::uint16_t mask = 0;
+      auto note = [&](Cull r, int bit) {
+        if (r == Cull::apart) ++hits.counters.separated_primitives;
+        if (r == Cull::test) mask = static_cast<std::uint16_t>(mask | (1u << bit));
+      };
+      for (size_t c = 0; c < 3; ++c)
+        if (own_i.vertex[static_cast<size_t>(ff[c])] == f && !repeats_earlier(ff, c))
+          note(vertex_face(i, vb_i, ff[c], gf, g_raw, swept_g, margin), static_cast<int>(c));
+      for (size_t c = 0; c < 3; ++c)
+        if (own_j.vertex[static_cast<size_t>(gf[c])] == g && !repeats_earlier(gf, c))
+          note(vertex_face(j, vb_j, gf[c], ff, f_raw, swept_f, margin), static_cast<int>(3 + c));
       const auto& fe = adj_i.triangle_edges(f);
       const auto& ge = adj_j.triangle_edges(g);
       for (size_t ka = 0; ka < 3; ++ka) {
@@ -838,21 +833,34 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
           const SweptPrimitives<2, 2> p{ends(oi, va), ends(ti, va), ends(oj, vb), ends(tj, vb)};
           const Vec3 cross_start = (p.a_start[1] - p.a_start[0]).cross(p.b_start[1] - p.b_start[0]);
           const Vec3 cross_end = (p.a_end[1] - p.a_end[0]).cross(p.b_end[1] - p.b_end[0]);
-          if (primitives_apart(p, {cross_start, cross_end}, 2 * margin)) {
-            ++apart;
-            continue;
-          }
-          if (probe) return true;
-          tested = true;
+          note(primitives_apart(p, {cross_start, cross_end}, 2 * margin) ? Cull::apart : Cull::test,
+               static_cast<int>(6 + 3 * ka + kb));
+        }
+      }
+      return mask;
+    };
+    // Stage III: the elementary tests of the primitive pairs in `mask` (from cull_pair()).
+    auto run_tests = [&](Index f, Index g, std::uint16_t mask) {
+      const Face& ff = oi.topology->faces[static_cast<size_t>(f)];
+      const Face& gf = oj.topology->faces[static_cast<size_t>(g)];
+      for (size_t c = 0; c < 3; ++c)
+        if (mask & (1u << c)) tester.vertex_face(i, ff[c], j, g, hits);
+      for (size_t c = 0; c < 3; ++c)
+        if (mask & (1u << (3 + c))) tester.vertex_face(j, gf[c], i, f, hits);
+      const auto& fe = adj_i.triangle_edges(f);
+      const auto& ge = adj_j.triangle_edges(g);
+      for (size_t ka = 0; ka < 3; ++ka)
+        for (size_t kb = 0; kb < 3; ++kb) {
+          if (!(mask & (1u << (6 + 3 * ka + kb)))) continue;
+          const Index ea = fe[ka], eb = ge[kb];
+          const auto& va = adj_i.edges()[static_cast<size_t>(ea)];
+          const auto& vb = adj_j.edges()[static_cast<size_t>(eb)];
           // Canonical order: the smaller (object, edge id) first.
           if (i < j || (self && ea < eb))
             tester.edge_edge(i, va, j, vb, hits);
           else
             tester.edge_edge(j, vb, i, va, hits);
         }
-      }
-      hits.counters.separated_primitives += apart;
-      return tested;
     };
 
     if (replay) {
@@ -861,7 +869,8 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
       // pairs of its run all dropped); then the pair must share a key.
       Index last_f = kNoIndex;
       bool f_kept = true;
-      for (const auto& [f, g] : candidates[k]) {
+      for (const Candidate& cand : candidates[k]) {
+        const Index f = cand.f, g = cand.g;
         if (!self) {
           if (f != last_f) {
             last_f = f;
@@ -877,7 +886,7 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
           ++hits.counters.unshared_pairs;
           continue;
         }
-        test_pair(f, g, false);
+        run_tests(f, g, cand.mask);
       }
       return;
     }
@@ -920,10 +929,12 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
         }
         // With Stage II, the pairs with a primitive pair to test are listed for it (the pairs
         // whose primitive pairs are all culled here need no voxels), and tested after it.
-        if (!stage2)
-          test_pair(f, g, false);
-        else if (test_pair(f, g, true))
-          candidates[k].emplace_back(f, g);
+        const std::uint16_t mask = cull_pair(f, g);
+        if (mask == 0) return;
+        if (stage2)
+          candidates[k].push_back({f, g, mask});
+        else
+          run_tests(f, g, mask);
       });
     }
   };
@@ -940,9 +951,9 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
       CcdTriangleMask used(from.objects.size());
       for (Index i : live) used[static_cast<size_t>(i)].assign(static_cast<size_t>(from.objects[static_cast<size_t>(i)].num_triangles()), 0);
       for (size_t k = 0; k < tasks.size(); ++k)
-        for (const auto& [f, g] : candidates[k]) {
-          used[static_cast<size_t>(tasks[k].i)][static_cast<size_t>(f)] = 1;
-          used[static_cast<size_t>(tasks[k].j)][static_cast<size_t>(g)] = 1;
+        for (const Candidate& c : candidates[k]) {
+          used[static_cast<size_t>(tasks[k].i)][static_cast<size_t>(c.f)] = 1;
+          used[static_cast<size_t>(tasks[k].j)][static_cast<size_t>(c.g)] = 1;
         }
       built = std::make_unique<CcdVoxelCulling>(from, to, sweep, CcdVoxelOptions{opts.voxel_grid, opts.voxel_slots, threads},
                                                 *opts.voxel_backend, &used);
