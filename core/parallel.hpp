@@ -14,10 +14,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <exception>
+#include <memory>
 #include <mutex>
 #include <thread>
 #include <type_traits>
 #include <vector>
+
+#include <signal.h>
 
 namespace vproxq {
 
@@ -29,6 +32,35 @@ inline int resolve_threads(int requested) {
 }
 
 namespace detail {
+
+/// An alternate signal stack for the calling thread while this lives. A handler installed
+/// with SA_ONSTACK then runs even for a stack overflow of this thread, which leaves no room on
+/// the thread's own stack: the CLI's fatal-signal handler removes the run's partial output
+/// (io/output.cpp), and the main thread gets its own stack there. sigaltstack() is per thread,
+/// so each pool thread sets one up. Without one (the call fails), such a handler cannot run
+/// on an overflow: the next run into the directory removes the temporaries then.
+class AlternateSignalStack {
+ public:
+  AlternateSignalStack() : memory_(new char[kSize]) {
+    stack_t ss{};
+    ss.ss_sp = memory_.get();
+    ss.ss_size = kSize;
+    installed_ = ::sigaltstack(&ss, nullptr) == 0;
+  }
+  ~AlternateSignalStack() {
+    if (!installed_) return;
+    stack_t ss{};
+    ss.ss_flags = SS_DISABLE;
+    ::sigaltstack(&ss, nullptr);
+  }
+  AlternateSignalStack(const AlternateSignalStack&) = delete;
+  AlternateSignalStack& operator=(const AlternateSignalStack&) = delete;
+
+ private:
+  static constexpr std::size_t kSize = std::size_t{1} << 16;
+  std::unique_ptr<char[]> memory_;
+  bool installed_ = false;
+};
 
 class ThreadPool {
  public:
@@ -99,6 +131,7 @@ class ThreadPool {
   }
 
   void worker(std::size_t index) {
+    const AlternateSignalStack signal_stack;
     std::unique_lock<std::mutex> lock(mutex_);
     std::uint64_t seen = 0;
     for (;;) {

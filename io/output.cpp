@@ -33,7 +33,8 @@ namespace fs = std::filesystem;
 // async-signal-safe calls only (unlink, rmdir, signal, raise): files first, then directories,
 // newest first; then the signal is raised again with its default action, so the exit status
 // (and a core dump, where enabled) still says which signal ended the run. The handler runs on
-// its own stack, so that a stack overflow still reaches it. What no handler sees (SIGKILL, as
+// its own stack, so that a stack overflow still reaches it (this one for the main thread; the
+// pool threads of core/parallel.hpp set up their own). What no handler sees (SIGKILL, as
 // from the out-of-memory killer) is cleaned up by the next run into the same directory:
 // remove_stale_temporaries().
 constexpr int kCleanupSlots = 16;
