@@ -774,7 +774,7 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
     // What the culling makes of a primitive pair: no test (boxes apart, or a vertex of the
     // face itself), shown apart along a separating axis, or an elementary test to run.
     enum class Cull { none, apart, test };
-    // Vertex v of object ov against face g of object og.
+    // Vertex v of object ov against a face (its vertex ids, swept box and swept triangle).
     auto vertex_face = [&](Index ov, const std::vector<AABB>& v_boxes, Index v, const Face& g_face,
                            const AABB& g_raw, const SweptTriangle& g_swept, double margin) {
       if (self && in_face(v, g_face)) return Cull::none;
