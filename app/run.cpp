@@ -19,7 +19,9 @@
 #include "io/scene_source.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -153,21 +155,34 @@ VoronoiFrameStats frame_stats(const Bounds& b, std::uint64_t samples) {
   return v;
 }
 
+/// Intra-object results of static objects (scene "static"), by topology. A static object is
+/// the same in every frame (read once: one topology, shared by the frames, and the same
+/// positions), and its intra-object result depends on it alone, so it is computed on the first
+/// frame of the run and reused on the others.
+using StaticIntraCache = std::map<const Topology*, IntraObjectDistance>;
+
 /// The intra-object ("self") part of the distance query: 2-ring bounds, the self Stage II when
-/// a backend runs (at `grid` when given, else its own default), Stage III. Its times add to
-/// the frame's voronoi and exact times.
+/// a backend runs (at `grid` when given, else its own default), Stage III, for every object
+/// but the static ones already in `statics` (whose results are copied from there). Its times
+/// add to the frame's voronoi and exact times.
 void run_intra(const Frame& frame, const FrameBoxes& boxes, VoronoiStage& voronoi, int grid,
-               int threads, FrameResult& result) {
+               int threads, FrameResult& result, StaticIntraCache& statics) {
   Stopwatch sw;
+  const std::size_t n = frame.objects.size();
+  std::vector<std::uint8_t> known(n, 0);
+  bool any_known = false;
+  for (std::size_t i = 0; i < n; ++i)
+    if (frame.objects[i].is_static && statics.count(frame.objects[i].topology.get()) != 0) known[i] = 1, any_known = true;
+  const std::vector<std::uint8_t>* skip = any_known ? &known : nullptr;
   // The 2-ring bounds are the intra query's Stage I (paper 5.2.2): they count as "aabb".
-  const auto ring2 = ring2_upper_bounds(frame, threads);
+  const auto ring2 = ring2_upper_bounds(frame, threads, skip);
   result.time_ms.intra_bounds = sw.elapsed_ms();
   result.time_ms.aabb += result.time_ms.intra_bounds;
-  IntraDistanceOptions opts{threads, nullptr};
+  IntraDistanceOptions opts{threads, nullptr, skip};
   SelfVoronoiBounds bounds;
   sw.restart();
   if (voronoi.self_backend) {
-    bounds = compute_self_voronoi_bounds(frame, boxes, ring2, *voronoi.self_backend, grid, threads);
+    bounds = compute_self_voronoi_bounds(frame, boxes, ring2, *voronoi.self_backend, grid, threads, skip);
     opts.voronoi = &bounds;
     result.self_voronoi = frame_stats(bounds, bounds.samples);
     result.self_voronoi->sampled_triangles = bounds.sampled_triangles;
@@ -182,6 +197,15 @@ void run_intra(const Frame& frame, const FrameBoxes& boxes, VoronoiStage& vorono
   result.counters.intra_separation_culled = d.counters.intra_separation_culled;
   result.counters.intra_reused = d.counters.intra_reused;
   result.counters.intra_exact_tests = d.counters.intra_exact_tests;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Object& o = frame.objects[i];
+    if (known[i] != 0) {
+      d.per_object[i] = statics.at(o.topology.get());
+      d.per_object[i].object = static_cast<Index>(i);
+    } else if (o.is_static) {
+      statics.emplace(o.topology.get(), d.per_object[i]);
+    }
+  }
   result.intra = std::move(d.per_object);
 }
 
@@ -225,6 +249,7 @@ void run(const Config& config) {
   // CCD of frame k covers the step k -> k+1 whenever the scene has frame k+1 (also past the
   // end of --frames); that frame is loaded once and reused as the next frame of the loop.
   std::optional<Frame> next_frame;
+  StaticIntraCache static_intra;
   Progress progress(info.frame_count, !config.quiet);
   for (long k = first; k < last; ++k) {
     Stopwatch total;
@@ -266,7 +291,7 @@ void run(const Config& config) {
         result.time_ms.exact = d.exact_ms;
         result.counters = d.counters;
         result.inter = std::move(d.per_object);
-        run_intra(frame, boxes, voronoi, grid, info.threads, result);
+        run_intra(frame, boxes, voronoi, grid, info.threads, result, static_intra);
       }
       // Discrete collisions (paper 3.2), then local penetration depth (3.3) from them; their
       // time counts as exact tests.

@@ -135,19 +135,21 @@ bool shares_vertex(const Object& o, Index f, Index g) {
 
 }  // namespace
 
-std::vector<std::vector<double>> ring2_upper_bounds(const Frame& frame, int threads) {
+std::vector<std::vector<double>> ring2_upper_bounds(const Frame& frame, int threads,
+                                                    const std::vector<std::uint8_t>* skip) {
   const size_t n_obj = frame.objects.size();
   std::vector<std::vector<double>> out(n_obj);
   for (size_t i = 0; i < n_obj; ++i)
     out[i].assign(static_cast<size_t>(frame.objects[i].num_triangles()), kInfinity);
-  const ObjectBlocks blocks(n_obj, [&](size_t i) { return ObjectBlocks::blocks_of(out[i].size()); });
+  auto left_out = [&](size_t i) { return skip != nullptr && i < skip->size() && (*skip)[i] != 0; };
+  const ObjectBlocks blocks(n_obj, [&](size_t i) { return left_out(i) ? 0 : ObjectBlocks::blocks_of(out[i].size()); });
   std::vector<const Adjacency*> adj(n_obj, nullptr);
   // The 2-ring vertices are computed and cached on the first frame of a topology: small
   // objects in parallel, each on one thread; then large ones one after the other, each on all
   // threads.
   constexpr size_t kLargeObject = 4096;  // triangles
   parallel_for(n_obj, threads, [&](size_t i) {
-    if (out[i].empty()) return;
+    if (out[i].empty() || left_out(i)) return;
     adj[i] = &adjacency(*frame.objects[i].topology);
     if (out[i].size() < kLargeObject) adj[i]->prepare_ring2_vertices(1);
   });
@@ -175,7 +177,7 @@ std::vector<std::vector<double>> ring2_upper_bounds(const Frame& frame, int thre
 IntraDistanceOutput intra_object_distance(const Frame& frame, const IntraDistanceOptions& opts) {
   const int threads = std::max(1, opts.threads);
   const FrameBoxes boxes = FrameBoxes::compute(frame, threads);
-  return intra_object_distance(frame, boxes, ring2_upper_bounds(frame, threads), opts);
+  return intra_object_distance(frame, boxes, ring2_upper_bounds(frame, threads, opts.skip), opts);
 }
 
 IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& boxes,
@@ -186,9 +188,10 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
   const int threads = std::max(1, opts.threads);
   const size_t n_obj = frame.objects.size();
   out.per_object.resize(n_obj);
+  auto left_out = [&](size_t i) { return opts.skip != nullptr && i < opts.skip->size() && (*opts.skip)[i] != 0; };
   for (size_t i = 0; i < n_obj; ++i) {
     out.per_object[i].object = static_cast<Index>(i);
-    out.per_object[i].per_triangle.assign(static_cast<size_t>(frame.objects[i].num_triangles()), {});
+    if (!left_out(i)) out.per_object[i].per_triangle.assign(static_cast<size_t>(frame.objects[i].num_triangles()), {});
   }
   // Objects of fewer than 2 triangles have no pairs: no blocks.
   const ObjectBlocks blocks(n_obj, [&](size_t i) {

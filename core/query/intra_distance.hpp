@@ -6,6 +6,7 @@
 #include "core/results.hpp"
 #include "core/scene.hpp"
 
+#include <cstdint>
 #include <vector>
 
 namespace vproxq {
@@ -26,13 +27,18 @@ struct SelfVoronoiBounds;
 /// cost of the order of its valence squared. Where a hub is skipped the bound comes
 /// from the part of the 2-ring reached without it (larger, or kInfinity), which is still an
 /// upper bound; where no vertex of valence above 64 is near f, it is the whole 2-ring's.
-std::vector<std::vector<double>> ring2_upper_bounds(const Frame& frame, int threads);
+/// With `skip`, objects it marks (1) are left out: their bounds stay kInfinity.
+std::vector<std::vector<double>> ring2_upper_bounds(const Frame& frame, int threads,
+                                                    const std::vector<std::uint8_t>* skip = nullptr);
 
 struct IntraDistanceOptions {
   int threads = 1;  ///< worker threads for Stage III (>= 1)
   /// Stage II's per-triangle bounds (D_u, D_l) for this frame, or null for AABB-only culling.
   /// They change which pairs are tested, never the answer.
   const SelfVoronoiBounds* voronoi = nullptr;
+  /// Per object, 1 to leave it out (its result has its object id and nothing else): for a
+  /// caller that has its result already. An object's result depends on that object alone.
+  const std::vector<std::uint8_t>* skip = nullptr;
 };
 
 struct IntraDistanceOutput {

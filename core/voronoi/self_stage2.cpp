@@ -86,7 +86,7 @@ void validate_self_dvd_input(const SelfDvdInput& in) {
 SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes,
                                               const std::vector<std::vector<double>>& ring2_bound,
                                               SelfVoronoiBackend& backend, int grid_resolution,
-                                              int threads) {
+                                              int threads, const std::vector<std::uint8_t>* skip) {
   Stopwatch sw;
   SelfVoronoiBounds out;
   const size_t n = frame.objects.size();
@@ -94,10 +94,14 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
   out.triangle_lower.resize(n);
   std::int64_t total_tris = 0;
   AABB scene;
+  // Objects with fewer than 2 triangles have no non-adjacent pair: nothing to sample; nor are
+  // those the caller leaves out.
+  auto sampled_object = [&](size_t i) {
+    return frame.objects[i].num_triangles() >= 2 && !(skip != nullptr && i < skip->size() && (*skip)[i] != 0);
+  };
   for (size_t i = 0; i < n; ++i) {
     out.triangle_lower[i].assign(static_cast<size_t>(frame.objects[i].num_triangles()), -kInfinity);
-    // Objects with fewer than 2 triangles have no non-adjacent pair: nothing to sample.
-    if (frame.objects[i].num_triangles() < 2) continue;
+    if (!sampled_object(i)) continue;
     total_tris += frame.objects[i].num_triangles();
     scene.extend(boxes.objects[i]);
   }
@@ -108,7 +112,7 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
     std::vector<double> size;
     size.reserve(static_cast<size_t>(total_tris));
     for (size_t i = 0; i < n; ++i) {
-      if (frame.objects[i].num_triangles() < 2) continue;
+      if (!sampled_object(i)) continue;
       for (const AABB& b : boxes.triangles[i]) size.push_back((b.hi - b.lo).maxCoeff());
     }
     auto mid = size.begin() + static_cast<std::ptrdiff_t>(size.size() / 2);
@@ -150,7 +154,7 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
   std::vector<std::uint64_t> sampled(n, 0);
   parallel_for(n, threads, [&](size_t i) {
     const Object& o = frame.objects[i];
-    if (o.num_triangles() < 2) return;
+    if (!sampled_object(i)) return;
     const Adjacency& adj = adjacency(*o.topology);
     for (Index t = 0; t < o.num_triangles(); ++t) {
       if (!(ring2_bound[i][static_cast<size_t>(t)] > kSelfSampleRing2OverDelta * out.delta)) continue;

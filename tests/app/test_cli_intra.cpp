@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cstdio>
 #include <fstream>
 
 namespace vproxq {
@@ -108,6 +109,77 @@ TEST(CliIntra, JsonAndHdf5EqualBruteForceWithEveryBackend) {
       }
     EXPECT_EQ(row, object.size());
     EXPECT_EQ(h5.rows("/frames/000000/distance/intra_min"), ref.per_object.size());
+  }
+}
+
+// Static geometry (scene "static") is the same in every frame: its intra-object results are
+// computed on the first frame of a run and reused. On every frame they still equal the brute
+// force, also where the static objects' ids shift (a piece breaks off a moving object, with
+// "objects": "components"), and a later frame runs fewer exact tests than the same frame run
+// alone.
+TEST(CliIntra, StaticObjectsAreComputedOnceAndEqualBruteForceOnEveryFrame) {
+  ScratchDir dir;
+  test::Rng rng(11);
+  Frame statics;
+  statics.objects.push_back(test::make_folded_sheet(rng, 10, 4, 0.1, 0.05, 0.1, "sheet"));
+  statics.objects.push_back(test::make_blob(rng, Vec3(3, 0, 0), 0.6, 1, 0.3, "rock"));
+  test::write_obj(statics, dir / "static.obj");
+  // Frame 0: one moving blob; frames 1 and 2: it moved and a second piece is there (so the
+  // static objects come after two moving ones).
+  for (int k = 0; k < 3; ++k) {
+    Frame f;
+    f.objects.push_back(test::make_blob(rng, Vec3(0.2 * k, 1.5, 0), 0.5, 1, 0.4, "mover"));
+    if (k > 0) f.objects.push_back(test::make_blob(rng, Vec3(1.5, 1.5 + 0.1 * k, 0), 0.3, 1, 0.4, "mover"));
+    test::write_obj(f, dir / ("frame_" + std::to_string(k) + ".obj"));
+  }
+  const auto scene = dir.write("scene.json", R"({"frames": {"pattern": "frame_%d.obj", "first": 0, "count": 3},
+    "objects": "components", "static": ["static.obj"]})");
+  const SceneSource source = SceneSource::open(scene);
+  for (const char* backend : {"off", "cpu", "gpu"}) {
+    SCOPED_TRACE(backend);
+    const fs::path out = dir / backend;
+    auto r = test::vproxq(quote(scene) + " -o " + quote(out) + " --quiet --threads 2 --queries=distance --voronoi=" + backend);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const nlohmann::json j = test::read_json(out / "results.json");
+    const Hdf5Reader h5(out / "results.h5");
+    for (std::size_t k = 0; k < 3; ++k) {
+      SCOPED_TRACE("frame " + std::to_string(k));
+      const Frame frame = source.load_frame(k);
+      ASSERT_EQ(frame.objects.size(), k == 0 ? 3u : 4u);
+      ASSERT_TRUE(frame.objects.back().is_static);
+      const auto ref = intra_object_distance_brute_force(frame);
+      const auto& intra = j["frames"][k]["distance"]["intra"];
+      ASSERT_EQ(intra.size(), ref.per_object.size());
+      for (size_t i = 0; i < ref.per_object.size(); ++i) {
+        const auto& e = ref.per_object[i];
+        EXPECT_EQ(intra[i]["object"].get<int>(), static_cast<int>(i));
+        ASSERT_TRUE(e.has_pair());
+        EXPECT_EQ(intra[i]["distance"].get<double>(), e.distance);
+        EXPECT_EQ(intra[i]["triangles"][0].get<int>(), e.triangles[0]);
+        EXPECT_EQ(intra[i]["triangles"][1].get<int>(), e.triangles[1]);
+      }
+      char group[64];
+      std::snprintf(group, sizeof group, "/frames/%06zu/distance/intra", k);
+      const auto object = h5.int_field(group, "object");
+      const auto nearest = h5.int_field(group, "nearest");
+      const auto distance = h5.double_field(group, "distance");
+      size_t row = 0;
+      for (size_t i = 0; i < ref.per_object.size(); ++i)
+        for (size_t t = 0; t < ref.per_object[i].per_triangle.size(); ++t, ++row) {
+          ASSERT_LT(row, object.size());
+          EXPECT_EQ(object[row], static_cast<std::int64_t>(i));
+          EXPECT_EQ(nearest[row], ref.per_object[i].per_triangle[t].nearest);
+          EXPECT_EQ(distance[row], ref.per_object[i].per_triangle[t].distance);
+        }
+      EXPECT_EQ(row, object.size());
+    }
+    // Frame 2 run alone computes the static objects too.
+    r = test::vproxq(quote(scene) + " -o " + quote(dir / "alone") + " --quiet --threads 2 --queries=distance --frames 2:3 --voronoi=" + backend);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const nlohmann::json alone = test::read_json(dir / "alone" / "results.json");
+    EXPECT_LT(j["frames"][2]["stats"]["intra_exact_tests"].get<std::uint64_t>(),
+              alone["frames"][0]["stats"]["intra_exact_tests"].get<std::uint64_t>());
+    EXPECT_EQ(j["frames"][2]["distance"]["intra"], alone["frames"][0]["distance"]["intra"]);
   }
 }
 
