@@ -21,6 +21,8 @@ packages=(
   g++ cmake make pkg-config
   libeigen3-dev libcli11-dev nlohmann-json3-dev libassimp-dev libhdf5-dev
   libgtest-dev
+  # h5dump: a test checks that the HDF5 output reads back with the HDF5 tools.
+  hdf5-tools
   # Headless OpenGL: EGL loader and headers, Mesa's EGL and llvmpipe driver.
   libegl1 libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
 )
