@@ -24,6 +24,49 @@ using test::read_json;
 using test::vproxq;
 
 
+/// The JSON distance.intra of a frame (one entry per object: its minimum) equals `ref`.
+void expect_intra_json(const nlohmann::json& intra, const IntraDistanceOutput& ref) {
+  ASSERT_EQ(intra.size(), ref.per_object.size());
+  for (size_t i = 0; i < ref.per_object.size(); ++i) {
+    const auto& e = ref.per_object[i];
+    EXPECT_EQ(intra[i]["object"].get<int>(), static_cast<int>(i));
+    if (!e.has_pair()) {
+      EXPECT_TRUE(intra[i]["distance"].is_null());
+      EXPECT_TRUE(intra[i]["triangles"].is_null());
+      continue;
+    }
+    EXPECT_EQ(intra[i]["distance"].get<double>(), e.distance);
+    EXPECT_EQ(intra[i]["triangles"][0].get<int>(), e.triangles[0]);
+    EXPECT_EQ(intra[i]["triangles"][1].get<int>(), e.triangles[1]);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(intra[i]["points"][0][c].get<double>(), e.points[0][c]);
+      EXPECT_EQ(intra[i]["points"][1][c].get<double>(), e.points[1][c]);
+    }
+  }
+}
+
+/// The HDF5 per-triangle table `table` (object-major) equals `ref`.
+void expect_intra_table(const Hdf5Reader& h5, const std::string& table, const IntraDistanceOutput& ref) {
+  const auto object = h5.int_field(table, "object");
+  const auto triangle = h5.int_field(table, "triangle");
+  const auto nearest = h5.int_field(table, "nearest");
+  const auto distance = h5.double_field(table, "distance");
+  const auto point_a = h5.double_field(table, "point_a");
+  size_t row = 0;
+  for (size_t i = 0; i < ref.per_object.size(); ++i)
+    for (size_t t = 0; t < ref.per_object[i].per_triangle.size(); ++t, ++row) {
+      ASSERT_LT(row, object.size());
+      const auto& e = ref.per_object[i].per_triangle[t];
+      EXPECT_EQ(object[row], static_cast<std::int64_t>(i));
+      EXPECT_EQ(triangle[row], static_cast<std::int64_t>(t));
+      EXPECT_EQ(nearest[row], e.nearest);
+      EXPECT_EQ(distance[row], e.distance);
+      if (e.nearest == kNoIndex) continue;
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(point_a[3 * row + static_cast<size_t>(c)], e.points[0][c]);
+    }
+  EXPECT_EQ(row, object.size());
+}
+
 TEST(CliIntra, JsonAndHdf5EqualBruteForceWithEveryBackend) {
   ScratchDir dir;
   test::Rng rng(3);
@@ -43,24 +86,7 @@ TEST(CliIntra, JsonAndHdf5EqualBruteForceWithEveryBackend) {
                                quote(out) + " --quiet --threads 2 --voronoi=" + backend);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     const nlohmann::json j = test::read_json(out / "results.json");
-    const auto& intra = j["frames"][0]["distance"]["intra"];
-    ASSERT_EQ(intra.size(), ref.per_object.size());
-    for (size_t i = 0; i < ref.per_object.size(); ++i) {
-      const auto& e = ref.per_object[i];
-      EXPECT_EQ(intra[i]["object"].get<int>(), static_cast<int>(i));
-      if (!e.has_pair()) {
-        EXPECT_TRUE(intra[i]["distance"].is_null());
-        EXPECT_TRUE(intra[i]["triangles"].is_null());
-        continue;
-      }
-      EXPECT_EQ(intra[i]["distance"].get<double>(), e.distance);
-      EXPECT_EQ(intra[i]["triangles"][0].get<int>(), e.triangles[0]);
-      EXPECT_EQ(intra[i]["triangles"][1].get<int>(), e.triangles[1]);
-      for (int c = 0; c < 3; ++c) {
-        EXPECT_EQ(intra[i]["points"][0][c].get<double>(), e.points[0][c]);
-        EXPECT_EQ(intra[i]["points"][1][c].get<double>(), e.points[1][c]);
-      }
-    }
+    expect_intra_json(j["frames"][0]["distance"]["intra"], ref);
     EXPECT_GT(j["frames"][0]["stats"]["intra_exact_tests"].get<std::uint64_t>(), 0u);
     EXPECT_EQ(j["frames"][0]["stats"].contains("self_voronoi"), std::string(backend) != "off");
     if (std::string(backend) != "off") {
@@ -87,27 +113,7 @@ TEST(CliIntra, JsonAndHdf5EqualBruteForceWithEveryBackend) {
 
     // HDF5: the per-triangle table, object-major.
     const Hdf5Reader h5(out / "results.h5");
-    const std::string table = "/frames/000000/distance/intra";
-    const auto object = h5.int_field(table, "object");
-    const auto triangle = h5.int_field(table, "triangle");
-    const auto nearest = h5.int_field(table, "nearest");
-    const auto distance = h5.double_field(table, "distance");
-    const auto point_a = h5.double_field(table, "point_a");
-    size_t row = 0;
-    for (size_t i = 0; i < ref.per_object.size(); ++i)
-      for (size_t t = 0; t < ref.per_object[i].per_triangle.size(); ++t, ++row) {
-        ASSERT_LT(row, object.size());
-        const auto& e = ref.per_object[i].per_triangle[t];
-        EXPECT_EQ(object[row], static_cast<std::int64_t>(i));
-        EXPECT_EQ(triangle[row], static_cast<std::int64_t>(t));
-        EXPECT_EQ(nearest[row], e.nearest);
-        EXPECT_EQ(distance[row], e.distance);
-        if (e.nearest == kNoIndex) continue;
-        for (int c = 0; c < 3; ++c) {
-          EXPECT_EQ(point_a[3 * row + static_cast<size_t>(c)], e.points[0][c]);
-        }
-      }
-    EXPECT_EQ(row, object.size());
+    expect_intra_table(h5, "/frames/000000/distance/intra", ref);
     EXPECT_EQ(h5.rows("/frames/000000/distance/intra_min"), ref.per_object.size());
   }
 }
@@ -148,30 +154,11 @@ TEST(CliIntra, StaticObjectsAreComputedOnceAndEqualBruteForceOnEveryFrame) {
       ASSERT_EQ(frame.objects.size(), k == 0 ? 3u : 4u);
       ASSERT_TRUE(frame.objects.back().is_static);
       const auto ref = intra_object_distance_brute_force(frame);
-      const auto& intra = j["frames"][k]["distance"]["intra"];
-      ASSERT_EQ(intra.size(), ref.per_object.size());
-      for (size_t i = 0; i < ref.per_object.size(); ++i) {
-        const auto& e = ref.per_object[i];
-        EXPECT_EQ(intra[i]["object"].get<int>(), static_cast<int>(i));
-        ASSERT_TRUE(e.has_pair());
-        EXPECT_EQ(intra[i]["distance"].get<double>(), e.distance);
-        EXPECT_EQ(intra[i]["triangles"][0].get<int>(), e.triangles[0]);
-        EXPECT_EQ(intra[i]["triangles"][1].get<int>(), e.triangles[1]);
-      }
+      for (const auto& e : ref.per_object) ASSERT_TRUE(e.has_pair());
+      expect_intra_json(j["frames"][k]["distance"]["intra"], ref);
       char group[64];
       std::snprintf(group, sizeof group, "/frames/%06zu/distance/intra", k);
-      const auto object = h5.int_field(group, "object");
-      const auto nearest = h5.int_field(group, "nearest");
-      const auto distance = h5.double_field(group, "distance");
-      size_t row = 0;
-      for (size_t i = 0; i < ref.per_object.size(); ++i)
-        for (size_t t = 0; t < ref.per_object[i].per_triangle.size(); ++t, ++row) {
-          ASSERT_LT(row, object.size());
-          EXPECT_EQ(object[row], static_cast<std::int64_t>(i));
-          EXPECT_EQ(nearest[row], ref.per_object[i].per_triangle[t].nearest);
-          EXPECT_EQ(distance[row], ref.per_object[i].per_triangle[t].distance);
-        }
-      EXPECT_EQ(row, object.size());
+      expect_intra_table(h5, group, ref);
     }
     // Frame 2 run alone computes the static objects too.
     r = test::vproxq(quote(scene) + " -o " + quote(dir / "alone") + " --quiet --threads 2 --queries=distance --frames 2:3 --voronoi=" + backend);

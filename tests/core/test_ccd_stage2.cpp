@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <map>
 #include <set>
+#include <utility>
 
 namespace vproxq {
 namespace {
@@ -137,9 +138,9 @@ TEST(CcdStage2, EveryPointSweptWithinTheMarginIsInAMarkedVoxelOfItsSlot) {
   EXPECT_GT(left_out, 500u);
 }
 
-TEST(CcdStage2, TimeSlotsCullAFastObjectsFrontAgainstItsBack) {
-  // A blob moving one diameter in the step: the swept prisms of its front and back overlap
-  // (the front sweeps through where the back was), but never at the same time.
+/// A blob moving one diameter in the step into a smaller one: the swept prisms of its front
+/// and back overlap (the front sweeps through where the back was), but never at the same time.
+std::pair<Frame, Frame> fast_blob_step() {
   test::Rng rng(3);
   Frame from;
   from.objects.push_back(test::make_blob(rng, Vec3(0, 0, 0), 1.0, 2, 0.05, "fast"));
@@ -147,6 +148,11 @@ TEST(CcdStage2, TimeSlotsCullAFastObjectsFrontAgainstItsBack) {
   Frame to = from;
   to.index = 1;
   for (Vec3& p : to.objects[0].positions) p += Vec3(2, 0.1, 0);  // runs into the target
+  return {from, to};
+}
+
+TEST(CcdStage2, TimeSlotsCullAFastObjectsFrontAgainstItsBack) {
+  const auto [from, to] = fast_blob_step();
   const CcdStepResult ref = continuous_collisions_brute_force(from, to);
   EXPECT_GT(ref.vf.size() + ref.ee.size(), 0u);
   const CcdSweep sweep = CcdSweep::compute(from, to, 2);
@@ -250,13 +256,7 @@ TEST(CcdStage2, BuiltOverTheCandidatePairsEqualsBruteForce) {
   }
   {
     SCOPED_TRACE("fast blob");
-    test::Rng rng(3);
-    Frame from;
-    from.objects.push_back(test::make_blob(rng, Vec3(0, 0, 0), 1.0, 2, 0.05, "fast"));
-    from.objects.push_back(test::make_blob(rng, Vec3(2.2, 0.3, 0), 0.5, 2, 0.05, "target"));
-    Frame to = from;
-    to.index = 1;
-    for (Vec3& p : to.objects[0].positions) p += Vec3(2, 0.1, 0);
+    const auto [from, to] = fast_blob_step();
     check(from, to);
   }
   std::printf("[          ] Stage II over the candidate pairs: %llu of %llu triangles voxelized, "
