@@ -290,6 +290,30 @@ TEST(ObjectBroadPhase, InterpenetratingObjectsGetABoundOfZero) {
   EXPECT_GE(zero, 5u);
 }
 
+// In a crowd, the candidates of U_i are often not the object i touches (many boxes lie at
+// distance 0); Stage I also walks to a few objects whose boxes overlap i's and probes there.
+// Random crowds of 40 blobs: the probe proves contact for most touching objects, never
+// claims it for the others, and the answers equal the brute force.
+TEST(ObjectBroadPhase, ContactIsFoundForMostTouchingObjectsOfACrowd) {
+  std::size_t touching = 0, proven = 0;
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const Frame frame = make_random_frame(seed + 60, 40, 4.0, 1);
+    const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
+    const ObjectBroadPhase bp = object_broad_phase(frame, boxes, 2);
+    const auto ref = inter_object_distance_brute_force(frame);
+    for (size_t i = 0; i < frame.objects.size(); ++i) {
+      EXPECT_GE(bp.upper_bound[i], ref.per_object[i].distance);
+      touching += ref.per_object[i].distance == 0;
+      proven += bp.upper_bound[i] == 0;
+    }
+    test::expect_same_inter(inter_object_distance(frame, {2, nullptr}), ref, "seed " + std::to_string(seed));
+  }
+  std::printf("[          ] touching objects with U_i = 0: %zu of %zu\n", proven, touching);
+  ASSERT_GT(touching, 40u);
+  EXPECT_GE(10 * proven, 9 * touching);
+}
+
 // A crowd of small objects, where the axis rule alone picks far objects and the PNS search
 // must not visit every object: the PNS is exactly the boxes within U_i (+ slack), sorted as
 // documented; U_i is at most the farthest-corner distance to every other box; the answers
