@@ -3,8 +3,10 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 namespace vproxq {
 
@@ -16,6 +18,12 @@ using Index = std::int32_t;
 using Face = std::array<Index, 3>;
 /// Three corner positions.
 using Triangle = std::array<Vec3, 3>;
+
+/// Whether item i (an object of a frame, a triangle of an object) is marked in a per-item flag
+/// vector: false without one, and for items past its end.
+inline bool marked(const std::vector<std::uint8_t>* mask, std::size_t i) {
+  return mask != nullptr && i < mask->size() && (*mask)[i] != 0;
+}
 
 inline constexpr double kInfinity = std::numeric_limits<double>::infinity();
 inline constexpr Index kNoIndex = -1;

@@ -76,12 +76,13 @@ constexpr int kContactWalks = 4;
 /// Whether a triangle incident to corner vb of b meets one of a's triangles whose boxes
 /// overlap theirs (the first kContactProbeTriangles that a's BVH lists; exact tests): then the
 /// objects touch. False says nothing.
-bool corner_touches(const Object& oa, const TriangleBvh& bvh_a, const Object& ob, Index vb) {
+bool corner_touches(const Object& oa, const TriangleBvh& bvh_a, const Object& ob,
+                    const std::vector<AABB>& boxes_b, Index vb) {
   if (vb == kNoIndex) return false;
   const IndexSpan around = adjacency(*ob.topology).vertex_triangles(vb);
   if (around.size() > kContactProbeValence) return false;
   AABB box;
-  for (const Index t : around) box.extend(AABB::of(ob.triangle(t)));
+  for (const Index t : around) box.extend(boxes_b[static_cast<size_t>(t)]);
   bool found = false;
   int probed = 0;
   const auto done = [&] { return found || probed >= kContactProbeTriangles; };
@@ -113,7 +114,8 @@ double vertex_walk_bound(const Frame& frame, const FrameBoxes& boxes, Index a, I
   const Corner w = nearest_corner(ob, bb, v.p);
   const Corner v2 = nearest_corner(oa, ba, w.p);
   if (boxes_overlap(boxes.objects[static_cast<size_t>(a)], boxes.objects[static_cast<size_t>(b)]) &&
-      (corner_touches(oa, ba, ob, w.vertex) || corner_touches(ob, bb, oa, v2.vertex)))
+      (corner_touches(oa, ba, ob, boxes.triangles[static_cast<size_t>(b)], w.vertex) ||
+       corner_touches(ob, bb, oa, boxes.triangles[static_cast<size_t>(a)], v2.vertex)))
     return 0;
   return (v2.p - w.p).norm();
 }

@@ -141,15 +141,14 @@ std::vector<std::vector<double>> ring2_upper_bounds(const Frame& frame, int thre
   std::vector<std::vector<double>> out(n_obj);
   for (size_t i = 0; i < n_obj; ++i)
     out[i].assign(static_cast<size_t>(frame.objects[i].num_triangles()), kInfinity);
-  auto left_out = [&](size_t i) { return skip != nullptr && i < skip->size() && (*skip)[i] != 0; };
-  const ObjectBlocks blocks(n_obj, [&](size_t i) { return left_out(i) ? 0 : ObjectBlocks::blocks_of(out[i].size()); });
+  const ObjectBlocks blocks(n_obj, [&](size_t i) { return marked(skip, i) ? 0 : ObjectBlocks::blocks_of(out[i].size()); });
   std::vector<const Adjacency*> adj(n_obj, nullptr);
   // The 2-ring vertices are computed and cached on the first frame of a topology: small
   // objects in parallel, each on one thread; then large ones one after the other, each on all
   // threads.
   constexpr size_t kLargeObject = 4096;  // triangles
   parallel_for(n_obj, threads, [&](size_t i) {
-    if (out[i].empty() || left_out(i)) return;
+    if (out[i].empty() || marked(skip, i)) return;
     adj[i] = &adjacency(*frame.objects[i].topology);
     if (out[i].size() < kLargeObject) adj[i]->prepare_ring2_vertices(1);
   });
@@ -188,10 +187,9 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
   const int threads = std::max(1, opts.threads);
   const size_t n_obj = frame.objects.size();
   out.per_object.resize(n_obj);
-  auto left_out = [&](size_t i) { return opts.skip != nullptr && i < opts.skip->size() && (*opts.skip)[i] != 0; };
   for (size_t i = 0; i < n_obj; ++i) {
     out.per_object[i].object = static_cast<Index>(i);
-    if (!left_out(i)) out.per_object[i].per_triangle.assign(static_cast<size_t>(frame.objects[i].num_triangles()), {});
+    if (!marked(opts.skip, i)) out.per_object[i].per_triangle.assign(static_cast<size_t>(frame.objects[i].num_triangles()), {});
   }
   // Objects of fewer than 2 triangles have no pairs: no blocks.
   const ObjectBlocks blocks(n_obj, [&](size_t i) {

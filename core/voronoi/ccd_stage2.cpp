@@ -227,7 +227,7 @@ CcdVoxelCulling::CcdVoxelCulling(const Frame& from, const Frame& to, const CcdSw
     const std::vector<std::uint8_t>* mask = only ? &(*only)[i] : nullptr;
     const Object& o = from.objects[i];
     for (Index t = 0; t < o.num_triangles(); ++t) {
-      if (mask && (static_cast<size_t>(t) >= mask->size() || !(*mask)[static_cast<size_t>(t)])) continue;
+      if (mask && !marked(mask, static_cast<size_t>(t))) continue;
       const std::int64_t g = first_[i] + t;
       record_of_[static_cast<size_t>(g)] = static_cast<std::int64_t>(tris.size());
       tris.push_back(g);

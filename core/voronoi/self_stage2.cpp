@@ -97,7 +97,7 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
   // Objects with fewer than 2 triangles have no non-adjacent pair: nothing to sample; nor are
   // those the caller leaves out.
   auto sampled_object = [&](size_t i) {
-    return frame.objects[i].num_triangles() >= 2 && !(skip != nullptr && i < skip->size() && (*skip)[i] != 0);
+    return frame.objects[i].num_triangles() >= 2 && !marked(skip, i);
   };
   for (size_t i = 0; i < n; ++i) {
     out.triangle_lower[i].assign(static_cast<size_t>(frame.objects[i].num_triangles()), -kInfinity);
