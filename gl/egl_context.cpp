@@ -453,6 +453,9 @@ std::unique_ptr<Context::Impl> try_display(const EglLibrary& egl, const DisplayC
                std::to_string(options.gl_major) + "." + std::to_string(options.gl_minor);
       return nullptr;
     }
+    info.core_profile = (gl_integer(gl, GL_CONTEXT_PROFILE_MASK,
+                                    "glGetIntegerv(GL_CONTEXT_PROFILE_MASK)") &
+                         GL_CONTEXT_CORE_PROFILE_BIT) != 0;
     info.software = cand.software_device || looks_like_software_renderer(info.gl_renderer);
     GLint64 block_size = 0;
     gl.GetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block_size);

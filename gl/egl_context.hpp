@@ -55,6 +55,9 @@ struct ContextInfo {
   std::string gl_version;   ///< GL_VERSION, e.g. "4.5 (Core Profile) Mesa 22.3.6"
   int gl_major = 0;         ///< GL_MAJOR_VERSION
   int gl_minor = 0;         ///< GL_MINOR_VERSION
+  /// GL_CONTEXT_PROFILE_MASK has GL_CONTEXT_CORE_PROFILE_BIT (GL_VERSION says so only on
+  /// some drivers: Mesa writes "(Core Profile)", NVIDIA does not).
+  bool core_profile = false;
   std::string egl_library;  ///< the library that was loaded
   std::string egl_version;  ///< EGL_VERSION of the display, e.g. "1.5"
   /// Which display was used: "EGL device 0: software device (EGL_MESA_device_software)",
