@@ -13,7 +13,8 @@
 #
 # Environment: THREADS (2), REPEAT (3), OBJECTS (200), FREQUENCY (3: 180 triangles per blob),
 # FRAMES (5), SEED (1), VORONOI (off,cpu,gpu: the backends to time), JOBS (build jobs, default:
-# nproc). The other build dependencies come
+# nproc), BIN_DIR (a folder with prebuilt vproxq-gen and vproxq-bench-fcl: skips the setup and
+# the build, e.g. on a GPU machine without the packages). The other build dependencies come
 # from scripts/setup.sh.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -27,17 +28,32 @@ seed=${SEED:-1}
 voronoi=${VORONOI:-off,cpu,gpu}
 jobs=${JOBS:-$(nproc 2>/dev/null || echo 2)}
 
-# FCL and the other Debian packages: the setup script installs what is missing.
-bash scripts/setup.sh --bench --no-build
+bin_dir=${BIN_DIR:-}
 
-cmake -S . -B build-bench -DCMAKE_BUILD_TYPE=Release -DVPROXQ_BUILD_BENCH=ON \
-  -DVPROXQ_BUILD_TESTS=OFF
-cmake --build build-bench --target vproxq-gen vproxq-bench-fcl -j"$jobs"
+if [ -n "$bin_dir" ]; then
+  gen=$bin_dir/vproxq-gen
+  fcl_bench=$bin_dir/vproxq-bench-fcl
+  for tool in "$gen" "$fcl_bench"; do
+    if [ ! -x "$tool" ]; then
+      echo "bench.sh: BIN_DIR=$bin_dir has no executable $(basename "$tool")" >&2
+      exit 2
+    fi
+  done
+else
+  # FCL and the other Debian packages: the setup script installs what is missing.
+  bash scripts/setup.sh --bench --no-build
+
+  cmake -S . -B build-bench -DCMAKE_BUILD_TYPE=Release -DVPROXQ_BUILD_BENCH=ON \
+    -DVPROXQ_BUILD_TESTS=OFF
+  cmake --build build-bench --target vproxq-gen vproxq-bench-fcl -j"$jobs"
+  gen=build-bench/sample_scenes/vproxq-gen
+  fcl_bench=build-bench/bench/vproxq-bench-fcl
+fi
 
 scene_dir=bench-out/blobs-$objects
-build-bench/sample_scenes/vproxq-gen blobs --objects "$objects" --frequency "$frequency" \
+"$gen" blobs --objects "$objects" --frequency "$frequency" \
   --frames "$frames" --seed "$seed" --out "$scene_dir"
 
 echo
-build-bench/bench/vproxq-bench-fcl "$scene_dir/scene.json" --threads "$threads" \
+"$fcl_bench" "$scene_dir/scene.json" --threads "$threads" \
   --repeat "$repeat" --voronoi "$voronoi" "$@" | tee "$scene_dir/fcl-bench.txt"

@@ -34,10 +34,14 @@
 #                                    and the paper's fixed-bound PNS, same frames as RANGE)
 #   GRID_SCENES  funnel              scenes of the grid sweep (the paper's figure 14 used its
 #                                    200-object scene); "" skips the sweep
-#   GRIDS        "32 48 64 96 128 192 256"   --grid values of the sweep (--voronoi=cpu)
+#   GRIDS        "32 48 64 96 128 192 256"   --grid values of the sweep (--voronoi=GRID_MODE)
 #   GRID_RANGE   (all)               --frames A:B of the sweep runs
 #   OUT          bench-out/report    report folder (its runs/ is replaced)
 #   JOBS         2                   build jobs
+#   BIN_DIR      (build-bench)       a folder with prebuilt vproxq, vproxq-gen, vproxq-bench-fcl,
+#                                    vproxq-bench-pns and vproxq-report: skips the setup and the
+#                                    build (a machine without the packages or the compiler)
+#   GRID_MODE    cpu                 the Stage II backend of the grid sweep (cpu or gpu)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -56,19 +60,35 @@ grids=${GRIDS:-32 48 64 96 128 192 256}
 grid_range=${GRID_RANGE:-}
 out=${OUT:-bench-out/report}
 jobs=${JOBS:-2}
+bin_dir=${BIN_DIR:-}
+grid_mode=${GRID_MODE:-cpu}
 
-bash scripts/setup.sh --bench --no-build
+if [ -n "$bin_dir" ]; then
+  gen=$bin_dir/vproxq-gen
+  vproxq=$bin_dir/vproxq
+  fcl_bench=$bin_dir/vproxq-bench-fcl
+  pns_bench=$bin_dir/vproxq-bench-pns
+  report=$bin_dir/vproxq-report
+  for tool in "$gen" "$vproxq" "$fcl_bench" "$pns_bench" "$report"; do
+    if [ ! -x "$tool" ]; then
+      echo "report.sh: BIN_DIR=$bin_dir has no executable $(basename "$tool")" >&2
+      exit 2
+    fi
+  done
+else
+  bash scripts/setup.sh --bench --no-build
 
-cmake -S . -B build-bench -DCMAKE_BUILD_TYPE=Release -DVPROXQ_BUILD_BENCH=ON \
-  -DVPROXQ_BUILD_TESTS=OFF
-cmake --build build-bench --target vproxq vproxq-gen vproxq-bench-fcl vproxq-bench-pns \
-  vproxq-report -j"$jobs"
+  cmake -S . -B build-bench -DCMAKE_BUILD_TYPE=Release -DVPROXQ_BUILD_BENCH=ON \
+    -DVPROXQ_BUILD_TESTS=OFF
+  cmake --build build-bench --target vproxq vproxq-gen vproxq-bench-fcl vproxq-bench-pns \
+    vproxq-report -j"$jobs"
 
-gen=build-bench/sample_scenes/vproxq-gen
-vproxq=build-bench/app/vproxq
-fcl_bench=build-bench/bench/vproxq-bench-fcl
-pns_bench=build-bench/bench/vproxq-bench-pns
-report=build-bench/bench/report/vproxq-report
+  gen=build-bench/sample_scenes/vproxq-gen
+  vproxq=build-bench/app/vproxq
+  fcl_bench=build-bench/bench/vproxq-bench-fcl
+  pns_bench=build-bench/bench/vproxq-bench-pns
+  report=build-bench/bench/report/vproxq-report
+fi
 
 # The requested queries that this vproxq implements (it says "not implemented" otherwise).
 ran_queries=()
@@ -158,7 +178,7 @@ for scene in $scenes; do
   for g in $grids; do
     case " $grid_scenes " in
       *" $scene "*)
-        run_vproxq "$out/runs/$scene/grid-$g" "$dir/scene.json" --voronoi=cpu --grid "$g" \
+        run_vproxq "$out/runs/$scene/grid-$g" "$dir/scene.json" --voronoi="$grid_mode" --grid "$g" \
           --threads "$threads" --queries="$query_list" ${grid_range:+--frames "$grid_range"}
         ;;
     esac
@@ -181,7 +201,11 @@ done
 } >"$out/machine.txt"
 
 "$report" --runs "$out/runs" --out "$out" --machine "$out/machine.txt"
-(cd "$out" && gnuplot fig13.gp && gnuplot fig14.gp)
+if command -v gnuplot >/dev/null 2>&1; then
+  (cd "$out" && gnuplot fig13.gp && gnuplot fig14.gp)
+else
+  echo "report.sh: note: no gnuplot here, fig13.png and fig14.png not drawn (their .gp files are in $out)"
+fi
 echo
 sed -n '/^## Table 1/,/^## Stages/p' "$out/report.md" | sed '$d'
 echo "report.sh: wrote $out/report.md, results.csv, summary.csv, fig13.png, fig14.png"

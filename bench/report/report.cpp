@@ -5,7 +5,7 @@
 //
 // Input, one folder per scene under --runs (scene order: the paper's, then by name):
 //   <scene>/off/results.json, cpu/results.json, gpu/results.json   vproxq -o, per Stage II mode
-//   <scene>/grid-<N>/results.json                                    vproxq --voronoi=cpu --grid N
+//   <scene>/grid-<N>/results.json                                    vproxq --voronoi=MODE --grid N
 //   <scene>/fcl.json                                                 vproxq-bench-fcl --json
 //   <scene>/pns.json (optional)                                      vproxq-bench-pns --json
 //   <scene>/<run>/error.txt or <scene>/fcl-error.txt                 why a run failed ("n/a")
@@ -99,6 +99,7 @@ struct Run {
   std::optional<std::string> error;
   std::vector<FrameRow> frames;
   std::string device;
+  std::string voronoi;  ///< settings.voronoi: the backend that ran (off, cpu, gpu)
   std::string queries;
   int threads = 0;
   int grid_setting = 0;  ///< --grid of a grid-N run
@@ -149,6 +150,8 @@ Run read_vproxq_run(const std::string& name, const fs::path& dir) {
   const json& settings = j.value("settings", json::object());
   if (settings.contains("device") && settings["device"].is_string())
     run.device = settings["device"].get<std::string>();
+  if (settings.contains("voronoi") && settings["voronoi"].is_string())
+    run.voronoi = settings["voronoi"].get<std::string>();
   run.threads = settings.value("threads", 0);
   if (settings.contains("grid") && settings["grid"].is_number()) run.grid_setting = settings["grid"].get<int>();
   for (const auto& q : j.value("queries", json::array()))
@@ -433,6 +436,23 @@ std::vector<std::string> grid_runs(const Scene& s) {
   return out;
 }
 
+/// The backend(s) the grid sweep ran with, as "--voronoi=cpu" (or "cpu, gpu" if they differ);
+/// "cpu" where the runs do not say (results from before settings.voronoi).
+std::string grid_modes(const std::vector<Scene>& scenes) {
+  std::vector<std::string> modes;
+  for (const Scene& s : scenes)
+    for (const std::string& g : grid_runs(s)) {
+      const Run& r = s.runs.at(g);
+      if (r.error) continue;
+      const std::string m = r.voronoi.empty() ? "cpu" : r.voronoi;
+      if (std::find(modes.begin(), modes.end(), m) == modes.end()) modes.push_back(m);
+    }
+  if (modes.empty()) modes.push_back("cpu");
+  std::string out = "--voronoi=" + modes[0];
+  for (std::size_t i = 1; i < modes.size(); ++i) out += ", " + modes[i];
+  return out;
+}
+
 void write_text(const fs::path& p, const std::string& text) {
   std::ofstream out(p, std::ios::binary | std::ios::trunc);
   out << text;
@@ -616,7 +636,7 @@ std::string report_markdown(const std::vector<Scene>& scenes, const std::string&
   bool any_grid = false;
   for (const Scene& s : scenes) any_grid = any_grid || !grid_runs(s).empty();
   if (any_grid) {
-    md << "\n## Grid resolution (figure 14, `--voronoi=cpu`)\n\n";
+    md << "\n## Grid resolution (figure 14, `" << grid_modes(scenes) << "`)\n\n";
     md << "| Benchmark | --grid | voxels | Voronoi ms | exact ms | query ms | exact tests |\n";
     md << "|---|---:|---|---:|---:|---:|---:|\n";
     for (const Scene& s : scenes)
@@ -731,7 +751,7 @@ std::string csv_summary(const std::vector<Scene>& scenes) {
           << m.load << ',' << m.aabb << ',' << m.voronoi << ',' << m.exact << ','
           << m.exact_tests << ',' << m.pns_pairs << ',' << m.feature_pns << ',' << m.fcl_build
           << ',' << m.fcl_query << ',' << m.fcl_vproxq << ',' << m.fcl_mismatches;
-      // Reductions (off / this run) for the Stage II modes; the grid runs use --voronoi=cpu.
+      // Reductions (off / this run) for the Stage II modes; the grid runs use GRID_MODE's backend.
       const bool voronoi_run = name != "fcl";
       for (int q = 0; q < kQueryKinds; ++q) {
         const Opt v = m.test_mean(q);
@@ -843,7 +863,7 @@ void write_fig14(const std::vector<Scene>& scenes, const fs::path& out) {
   if (index == 0) {
     gp += "set title 'no grid sweep was run'\nunset border\nunset tics\nplot [0:1][0:1] NaN notitle\n";
   } else {
-    gp += "set multiplot layout 1,2 title 'Grid resolution (--voronoi=cpu)'\n"
+    gp += "set multiplot layout 1,2 title 'Grid resolution (" + grid_modes(scenes) + ")'\n"
           "set xlabel '--grid (voxels along the longest axis)'\n"
           "set grid\nset key top left\n"
           "set ylabel 'ms per frame'\n"
