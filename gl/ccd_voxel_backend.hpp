@@ -8,7 +8,9 @@
 #include "gl/compute.hpp"
 
 #include <cstddef>
+#include <optional>
 #include <string>
+#include <vector>
 
 namespace vproxq::gl {
 
@@ -35,9 +37,20 @@ class GlCcdVoxelBackend final : public CcdVoxelBackend {
   bool last_fell_back() const { return last_fell_back_; }
 
  private:
+  /// One batch's buffers, kept for the next call.
+  struct BatchBuffers {
+    std::optional<StorageBuffer> records, offsets, objects, keys, counts, foreign;
+  };
+  /// `buffer` with at least `bytes` bytes: kept if large enough, else allocated anew with
+  /// half again as many bytes, at most `cap` (but never fewer than `bytes`).
+  StorageBuffer& reserve(std::optional<StorageBuffer>& buffer, std::size_t bytes, std::size_t cap,
+                         GLenum usage);
+
   const Context& context_;
   GlCcdVoxelOptions options_;
   ComputeProgram program_;
+  std::optional<StorageBuffer> table_;  ///< the co-occupancy table (its first key_count words)
+  std::vector<BatchBuffers> batch_buffers_;
   std::size_t last_batch_count_ = 0;
   bool last_fell_back_ = false;
 };

@@ -250,6 +250,24 @@ void StorageBuffer::clear_to_zero() {
   check_gl(gl, "glBindBuffer(GL_COPY_WRITE_BUFFER, 0)");
 }
 
+void StorageBuffer::clear_to_zero(std::size_t bytes) {
+  check_range(0, bytes, size_, "clear_to_zero");
+  if (bytes == 0) return;
+  const GlFunctions& gl = *gl_;
+  gl.BindBuffer(GL_COPY_WRITE_BUFFER, buffer_);
+  check_gl(gl, "glBindBuffer(GL_COPY_WRITE_BUFFER)");
+  if (bytes % 4 == 0) {
+    gl.ClearBufferSubData(GL_COPY_WRITE_BUFFER, GL_R32UI, 0, static_cast<GLsizeiptr>(bytes),
+                          GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+  } else {
+    gl.ClearBufferSubData(GL_COPY_WRITE_BUFFER, GL_R8UI, 0, static_cast<GLsizeiptr>(bytes),
+                          GL_RED_INTEGER, GL_UNSIGNED_BYTE, nullptr);
+  }
+  check_gl(gl, "glClearBufferSubData");
+  gl.BindBuffer(GL_COPY_WRITE_BUFFER, 0);
+  check_gl(gl, "glBindBuffer(GL_COPY_WRITE_BUFFER, 0)");
+}
+
 void StorageBuffer::bind(GLuint binding) const {
   if (static_cast<std::int64_t>(size_) > info_->max_ssbo_block_size) {
     throw GlError("a storage buffer of " + std::to_string(size_) +

@@ -98,6 +98,9 @@ class StorageBuffer {
   }
   /// Sets every byte to zero (glClearBufferData).
   void clear_to_zero();
+  /// Sets the first `bytes` bytes to zero (glClearBufferSubData, in 32-bit words where
+  /// `bytes` is a multiple of 4).
+  void clear_to_zero(std::size_t bytes);
   /// Binds the whole buffer to `layout(binding = binding)` shader storage blocks. Throws
   /// GlError when the buffer is larger than GL_MAX_SHADER_STORAGE_BLOCK_SIZE.
   void bind(GLuint binding) const;

@@ -47,6 +47,7 @@ namespace vproxq::gl {
   X(BufferSubData, PFNGLBUFFERSUBDATAPROC)                      \
   X(GetBufferSubData, PFNGLGETBUFFERSUBDATAPROC)                \
   X(ClearBufferData, PFNGLCLEARBUFFERDATAPROC)                  \
+  X(ClearBufferSubData, PFNGLCLEARBUFFERSUBDATAPROC)            \
   X(DispatchCompute, PFNGLDISPATCHCOMPUTEPROC)                  \
   X(MemoryBarrier, PFNGLMEMORYBARRIERPROC)                      \
   X(GenQueries, PFNGLGENQUERIESPROC)                            \

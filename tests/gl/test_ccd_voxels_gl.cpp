@@ -36,6 +36,38 @@ TEST(CcdVoxelsGl, RandomRecordsEqualTheReferenceAndTheCpu) {
   }
 }
 
+// The backend keeps its buffers from one call to the next (growing only): calls of every size
+// order, with and without co-occupancy and in one or many batches, each give what a fresh CPU
+// backend gives. A table, key room or count left over from a larger call must not show.
+TEST(CcdVoxelsGl, BuffersKeptFromCallToCallGiveTheSameOutputAsFreshOnes) {
+  VPROXQ_GL_CONTEXT_OR_FAIL(context);
+  GlCcdVoxelBackend gpu(context);
+  GlCcdVoxelBackend small_batches(context, GlCcdVoxelOptions{32, 4096});
+  const auto cpu = make_cpu_ccd_voxel_backend(2);
+  struct Call {
+    std::array<std::int32_t, 3> dims;
+    int records;
+    bool cooccupancy;
+  };
+  const Call calls[] = {{{12, 10, 9}, 800, true}, {{5, 4, 3}, 30, true},   {{12, 10, 9}, 800, true},
+                        {{6, 6, 6}, 200, false},  {{9, 7, 8}, 1200, true}, {{4, 4, 4}, 1, true},
+                        {{7, 7, 7}, 300, true}};
+  std::uint64_t seed = 100;
+  for (const Call& call : calls) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    CcdVoxelInput in = test::random_ccd_voxel_input(seed++, call.dims, 3, call.records);
+    in.cooccupancy = call.cooccupancy;
+    const CcdVoxelOutput c = cpu->voxelize(in);
+    for (GlCcdVoxelBackend* b : {&gpu, &small_batches}) {
+      const CcdVoxelOutput g = b->voxelize(in);
+      test::expect_ccd_output_matches_reference(in, g);
+      EXPECT_EQ(g.counts, c.counts);
+      EXPECT_EQ(g.foreign, c.foreign);
+      EXPECT_FALSE(b->last_fell_back());
+    }
+  }
+}
+
 // Records whose boxes hold more voxels than one invocation may loop over on some drivers
 // (llvmpipe stops every loop of an invocation after 65535 iterations in all): the output still
 // equals the reference, the shader reporting the boxes it could not finish and the backend

@@ -238,6 +238,11 @@ TEST(GlCompute, StorageBufferRoundTripAndBounds) {
   const std::uint32_t patch[2] = {7, 8};
   buffer.upload(patch, sizeof patch, 4 * sizeof(std::uint32_t));
   EXPECT_EQ(buffer.download_vector<std::uint32_t>(3, 3), (std::vector<std::uint32_t>{9, 7, 8}));
+  buffer.clear_to_zero(12);  // the first 3 words only
+  EXPECT_EQ(buffer.download_vector<std::uint32_t>(4), (std::vector<std::uint32_t>{0, 0, 0, 9}));
+  buffer.clear_to_zero(13);  // and one byte of the fourth
+  EXPECT_EQ(buffer.download_vector<std::uint32_t>(2, 3), (std::vector<std::uint32_t>{0, 7}));
+  EXPECT_THROW(buffer.clear_to_zero(buffer.size() + 1), std::out_of_range);
   buffer.clear_to_zero();
   EXPECT_EQ(buffer.download_vector<std::uint32_t>(values.size()),
             std::vector<std::uint32_t>(values.size(), 0));
