@@ -29,16 +29,13 @@ voronoi=${VORONOI:-off,cpu,gpu}
 jobs=${JOBS:-$(nproc 2>/dev/null || echo 2)}
 
 bin_dir=${BIN_DIR:-}
+# shellcheck source=prebuilt.sh
+source scripts/prebuilt.sh
 
 if [ -n "$bin_dir" ]; then
   gen=$bin_dir/vproxq-gen
   fcl_bench=$bin_dir/vproxq-bench-fcl
-  for tool in "$gen" "$fcl_bench"; do
-    if [ ! -x "$tool" ]; then
-      echo "bench.sh: BIN_DIR=$bin_dir has no executable $(basename "$tool")" >&2
-      exit 2
-    fi
-  done
+  prebuilt_tools bench.sh "$bin_dir" vproxq-gen vproxq-bench-fcl
 else
   # FCL and the other Debian packages: the setup script installs what is missing.
   bash scripts/setup.sh --bench --no-build

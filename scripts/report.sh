@@ -61,6 +61,8 @@ grid_range=${GRID_RANGE:-}
 out=${OUT:-bench-out/report}
 jobs=${JOBS:-2}
 bin_dir=${BIN_DIR:-}
+# shellcheck source=prebuilt.sh
+source scripts/prebuilt.sh
 grid_mode=${GRID_MODE:-cpu}
 
 if [ -n "$bin_dir" ]; then
@@ -69,12 +71,7 @@ if [ -n "$bin_dir" ]; then
   fcl_bench=$bin_dir/vproxq-bench-fcl
   pns_bench=$bin_dir/vproxq-bench-pns
   report=$bin_dir/vproxq-report
-  for tool in "$gen" "$vproxq" "$fcl_bench" "$pns_bench" "$report"; do
-    if [ ! -x "$tool" ]; then
-      echo "report.sh: BIN_DIR=$bin_dir has no executable $(basename "$tool")" >&2
-      exit 2
-    fi
-  done
+  prebuilt_tools report.sh "$bin_dir" vproxq-gen vproxq vproxq-bench-fcl vproxq-bench-pns vproxq-report
 else
   bash scripts/setup.sh --bench --no-build
 

@@ -3,6 +3,7 @@
 // keys, counts, co-occupancy flags, and the culling decisions and results of the pipeline.
 #include <gtest/gtest.h>
 
+#include <initializer_list>
 #include <iostream>
 
 #include "core/query/ccd.hpp"
@@ -16,6 +17,19 @@
 namespace vproxq::gl {
 namespace {
 
+// Each GL backend's output for `in` against the reference and the CPU backend's output `c`
+// (and that no backend redid the input on the CPU).
+void expect_gl_backends_match(const CcdVoxelInput& in, const CcdVoxelOutput& c,
+                              std::initializer_list<GlCcdVoxelBackend*> backends) {
+  for (GlCcdVoxelBackend* b : backends) {
+    const CcdVoxelOutput g = b->voxelize(in);
+    test::expect_ccd_output_matches_reference(in, g);
+    EXPECT_EQ(g.counts, c.counts);
+    EXPECT_EQ(g.foreign, c.foreign);
+    EXPECT_FALSE(b->last_fell_back());
+  }
+}
+
 TEST(CcdVoxelsGl, RandomRecordsEqualTheReferenceAndTheCpu) {
   VPROXQ_GL_CONTEXT_OR_FAIL(context);
   GlCcdVoxelBackend gpu(context);
@@ -25,13 +39,7 @@ TEST(CcdVoxelsGl, RandomRecordsEqualTheReferenceAndTheCpu) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     CcdVoxelInput in = test::random_ccd_voxel_input(seed, {6 + static_cast<int>(seed), 8, 5}, 4, 500);
     in.cooccupancy = seed % 3 != 0;
-    const CcdVoxelOutput c = cpu->voxelize(in);
-    for (GlCcdVoxelBackend* b : {&gpu, &small_batches}) {
-      const CcdVoxelOutput g = b->voxelize(in);
-      test::expect_ccd_output_matches_reference(in, g);
-      EXPECT_EQ(g.counts, c.counts);
-      EXPECT_EQ(g.foreign, c.foreign);
-    }
+    expect_gl_backends_match(in, cpu->voxelize(in), {&gpu, &small_batches});
     EXPECT_GT(small_batches.last_batch_count(), 1u);
   }
 }
@@ -57,14 +65,7 @@ TEST(CcdVoxelsGl, BuffersKeptFromCallToCallGiveTheSameOutputAsFreshOnes) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     CcdVoxelInput in = test::random_ccd_voxel_input(seed++, call.dims, 3, call.records);
     in.cooccupancy = call.cooccupancy;
-    const CcdVoxelOutput c = cpu->voxelize(in);
-    for (GlCcdVoxelBackend* b : {&gpu, &small_batches}) {
-      const CcdVoxelOutput g = b->voxelize(in);
-      test::expect_ccd_output_matches_reference(in, g);
-      EXPECT_EQ(g.counts, c.counts);
-      EXPECT_EQ(g.foreign, c.foreign);
-      EXPECT_FALSE(b->last_fell_back());
-    }
+    expect_gl_backends_match(in, cpu->voxelize(in), {&gpu, &small_batches});
   }
 }
 
