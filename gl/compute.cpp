@@ -240,15 +240,7 @@ void StorageBuffer::download(void* data, std::size_t bytes, std::size_t offset) 
   check_gl(gl, "glBindBuffer(GL_COPY_READ_BUFFER, 0)");
 }
 
-void StorageBuffer::clear_to_zero() {
-  const GlFunctions& gl = *gl_;
-  gl.BindBuffer(GL_COPY_WRITE_BUFFER, buffer_);
-  check_gl(gl, "glBindBuffer(GL_COPY_WRITE_BUFFER)");
-  gl.ClearBufferData(GL_COPY_WRITE_BUFFER, GL_R8UI, GL_RED_INTEGER, GL_UNSIGNED_BYTE, nullptr);
-  check_gl(gl, "glClearBufferData");
-  gl.BindBuffer(GL_COPY_WRITE_BUFFER, 0);
-  check_gl(gl, "glBindBuffer(GL_COPY_WRITE_BUFFER, 0)");
-}
+void StorageBuffer::clear_to_zero() { clear_to_zero(size_); }
 
 void StorageBuffer::clear_to_zero(std::size_t bytes) {
   check_range(0, bytes, size_, "clear_to_zero");

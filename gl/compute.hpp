@@ -96,10 +96,10 @@ class StorageBuffer {
     download(out.data(), count * sizeof(T), first * sizeof(T));
     return out;
   }
-  /// Sets every byte to zero (glClearBufferData).
+  /// Sets every byte to zero.
   void clear_to_zero();
   /// Sets the first `bytes` bytes to zero (glClearBufferSubData, in 32-bit words where
-  /// `bytes` is a multiple of 4).
+  /// `bytes` is a multiple of 4). Throws std::out_of_range past size().
   void clear_to_zero(std::size_t bytes);
   /// Binds the whole buffer to `layout(binding = binding)` shader storage blocks. Throws
   /// GlError when the buffer is larger than GL_MAX_SHADER_STORAGE_BLOCK_SIZE.

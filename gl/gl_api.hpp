@@ -46,7 +46,6 @@ namespace vproxq::gl {
   X(BufferData, PFNGLBUFFERDATAPROC)                            \
   X(BufferSubData, PFNGLBUFFERSUBDATAPROC)                      \
   X(GetBufferSubData, PFNGLGETBUFFERSUBDATAPROC)                \
-  X(ClearBufferData, PFNGLCLEARBUFFERDATAPROC)                  \
   X(ClearBufferSubData, PFNGLCLEARBUFFERSUBDATAPROC)            \
   X(DispatchCompute, PFNGLDISPATCHCOMPUTEPROC)                  \
   X(MemoryBarrier, PFNGLMEMORYBARRIERPROC)                      \
