@@ -213,6 +213,12 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
       return crowded ? owners->other_within(box, r, static_cast<Index>(i))
                      : std::any_of(near[i].begin(), near[i].end(), [&](Index j) { return within(box, static_cast<size_t>(j), r); });
     };
+    // An object whose Stage I bound is 0 is proven to touch another: no sample can lower its
+    // D_u, and with a band of δ (+ slack) a sample culls one of its triangles only where nothing
+    // lies within δ of the voxel centre, which saves few exact tests (Stage III then looks only
+    // at touching boxes). So its triangles near another object are not sampled and stay
+    // uncullable (D_l = -inf); the others get the band as before. See README, "Stage II".
+    const bool touching = stage1.upper_bound[i] == 0;
     // Whether a voxel's centre lies within reach of another object's triangle box, against all
     // of near[i]: the answer does not depend on the triangle, so it is found once per voxel
     // (neighbouring triangles share most of their voxels) and remembered over the object's
@@ -222,7 +228,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
     for (size_t a = 0; a < 3; ++a) span[a] = std::int64_t{chi[a]} - clo[a] + 1;
     const std::int64_t cells = span[0] * span[1] * span[2];
     thread_local std::vector<std::uint8_t> memo;  // 0: not decided, 1: keep, 2: leave out
-    memo.assign(cells <= kMaxMemoCells ? static_cast<size_t>(cells) : 0, 0);
+    memo.assign(!touching && cells <= kMaxMemoCells ? static_cast<size_t>(cells) : 0, 0);
     auto keep_voxel = [&](const StageGrid::Cell& c, std::int64_t id) {
       std::uint8_t* m = nullptr;
       if (!memo.empty()) {
@@ -241,6 +247,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
         lower[static_cast<size_t>(t)] = band_len[i];
         continue;
       }
+      if (touching) continue;
       ++sampled[i];
       sg.voxelize_cells(o.triangle(t), bt, [&](const StageGrid::Cell& c, std::int64_t id) {
         if (keep_voxel(c, id))

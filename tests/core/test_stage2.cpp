@@ -120,6 +120,30 @@ TEST(Stage2, AnObjectWithoutTrianglesIsLeftAlone) {
   });
 }
 
+// An object that Stage I proves to touch another (U_i = 0) is not sampled: no sample can lower
+// its D_u, and its triangles near another object stay uncullable. Two interpenetrating blobs
+// and a third one apart: only the third one's triangles are sampled, and the bounds and
+// answers stay those of brute force.
+TEST(Stage2, ObjectsProvenToTouchAreNotSampled) {
+  test::Rng rng(11);
+  Frame frame;
+  frame.objects.push_back(test::make_blob(rng, Vec3(0, 0, 0), 0.5, 2, 0.05, "a"));
+  frame.objects.push_back(test::make_blob(rng, Vec3(0.6, 0.1, 0), 0.5, 2, 0.05, "b"));
+  frame.objects.push_back(test::make_blob(rng, Vec3(0.3, 1.1, 0), 0.5, 2, 0.05, "c"));
+  const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
+  const ObjectBroadPhase stage1 = object_broad_phase(frame, boxes, 2);
+  ASSERT_EQ(stage1.upper_bound[0], 0.0);
+  ASSERT_EQ(stage1.upper_bound[1], 0.0);
+  ASSERT_GT(stage1.upper_bound[2], 0.0);
+  const auto third = static_cast<std::uint64_t>(frame.objects[2].num_triangles());
+  expect_bounds_at_grids(frame, {8, 24, 48}, "touching blobs", [&](const VoronoiBounds& vb) {
+    EXPECT_GT(vb.sampled_triangles, 0u);
+    EXPECT_LE(vb.sampled_triangles, third);
+    EXPECT_EQ(vb.object_upper[0], 0.0);
+    EXPECT_EQ(vb.object_upper[1], 0.0);
+  });
+}
+
 // Stage II samples only where another object may lie within the band: a triangle whose box is
 // farther than its object's band from every other object's box is not sampled and gets
 // D_l = band (its samples could give at most band - δ), and of the others only the voxels
