@@ -18,9 +18,6 @@ namespace vproxq {
 namespace {
 
 // Voxelization and its slack: StageGrid (grid_setup.hpp), shared with the self Stage II.
-// Bands are capped at this many cells: a narrower band only weakens culling, never
-// correctness (values at the cap give D_l = cap - δ, which then simply does not cull).
-constexpr double kMaxBandCells = 3.0;
 // Bins of this many voxels per side for the backends' triangle lookup (more on very fine
 // grids: bin_size_for()).
 constexpr std::int32_t kBinSize = 4;
@@ -146,10 +143,10 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   const double slack = rounding_slack(boxes.magnitude);
 
   // Bands: object i needs exact values up to U_i + δ (+ slack) so that its capped triangles
-  // are culled (D_l = band - δ > D_u); capped at kMaxBandCells cells.
+  // are culled (D_l = band - δ > D_u); capped at kMaxInterBandCells cells.
   std::vector<double> band_len(n);
   for (size_t i = 0; i < n; ++i)
-    band_len[i] = std::min(stage1.upper_bound[i] + out.delta + slack, kMaxBandCells * grid.cell);
+    band_len[i] = std::min(stage1.upper_bound[i] + out.delta + slack, kMaxInterBandCells * grid.cell);
   // The sampling filter's tests below reach a little past the band, so that rounding cannot
   // skip what lies within it: a voxel centre (origin + cell * (index + 1/2)) is within
   // 2^-52 (M + E) of its exact value per coordinate (M: largest coordinate magnitude, E: grid

@@ -10,6 +10,18 @@
 
 namespace vproxq {
 
+/// Bands are capped at this many cells: a narrower band only weakens culling, never
+/// correctness (values at the cap give D_l = cap - δ, which culls only where D_u fell below
+/// cap - δ). A capped band culls where the object's SD~ + 2δ (δ ~ 0.87 cell) lies below it, so
+/// 2 cells keep the culling of objects nearer than ~0.27 cell to another, 3 cells that of
+/// objects up to ~1.27 cells away. Measured (cpu backend, 2 threads), 3 -> 2 cells: the
+/// 200-object scene's inter-object distance 31-34 -> 23-26 ms per frame (two runs each,
+/// bench.sh's frames, best of 5) with 0.9% more exact tests on frame 2 and the same on the
+/// others; the report scenes' frames 10-15, exact tests +6% on skirt (2,262 -> 2,392 per
+/// frame), +1% on funnel, the same on cloth-ball and breaking, and Stage II 5-10% faster
+/// (skirt's query time within its run-to-run spread). 1.5 cells: 20-22 ms, skirt +37%.
+inline constexpr double kMaxInterBandCells = 2.0;
+
 /// Grid resolution used when none is given: 4 * cbrt(triangles), clamped to [32, 256] cells
 /// along the longest axis (paper fig. 14: the best resolution grows with scene complexity).
 int default_grid_resolution(std::int64_t triangles);

@@ -158,11 +158,13 @@ TEST(Stage2, OnlyTrianglesNearAnotherObjectAreSampled) {
   const ObjectBroadPhase stage1 = object_broad_phase(frame, boxes, 2);
   auto backend = make_cpu_voronoi_backend(2);
   const auto ref = inter_object_distance_brute_force(frame);
-  for (int grid : {16, 64, 200}) {
+  // Grids at which the band (at most kMaxInterBandCells cells) reaches from the blob to the
+  // sheet, about 0.1 below it (at 200 cells, 2 cells are 0.1: nothing is sampled).
+  for (int grid : {16, 64, 120}) {
     SCOPED_TRACE("grid " + std::to_string(grid));
     const VoronoiBounds vb = compute_voronoi_bounds(frame, boxes, stage1, *backend, grid, 2);
     const double cell = vb.grid.cell;
-    // The sample voxels lie within the band (<= 3 cells) of the blob's box, plus the sheet's
+    // The sample voxels lie within the band (<= kMaxInterBandCells cells) of the blob's box, plus the sheet's
     // triangles' voxels around it: at most this many.
     const Vec3 reach = boxes.objects[1].hi - boxes.objects[1].lo + Vec3::Constant(2 * 4 * cell);
     const double near_voxels = (reach / cell + Vec3::Ones()).prod();
@@ -173,14 +175,14 @@ TEST(Stage2, OnlyTrianglesNearAnotherObjectAreSampled) {
     const auto blob = static_cast<std::uint64_t>(frame.objects[1].num_triangles());
     ASSERT_GE(vb.backend_triangles, blob);
     EXPECT_LT(vb.backend_triangles - blob, static_cast<std::uint64_t>(frame.objects[0].num_triangles() / 2));
-    const double band0 = std::min(stage1.upper_bound[0] + vb.delta, 3 * cell);
+    const double band0 = std::min(stage1.upper_bound[0] + vb.delta, kMaxInterBandCells * cell);
     Index far = 0;
     for (size_t i = 0; i < 2; ++i) {
       EXPECT_GE(vb.object_upper[i], ref.per_object[i].distance);
       for (Index t = 0; t < frame.objects[i].num_triangles(); ++t) {
         const double lower = vb.triangle_lower[i][static_cast<size_t>(t)];
         ASSERT_LE(lower, exact_triangle_separation(frame, i, t)) << "object " << i << " triangle " << t;
-        if (i == 0 && std::sqrt(box_distance_squared(boxes.triangles[0][static_cast<size_t>(t)], boxes.objects[1])) > 3 * cell) {
+        if (i == 0 && std::sqrt(box_distance_squared(boxes.triangles[0][static_cast<size_t>(t)], boxes.objects[1])) > kMaxInterBandCells * cell) {
           ++far;
           ASSERT_GE(lower, band0) << "triangle " << t;
         }
