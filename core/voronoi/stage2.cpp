@@ -155,8 +155,20 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   // farther than the band. (The frame's rounding slack, ~4.5e5 ulps of M, would do too, but
   // far from the origin it spans the whole grid: 18 grains at 1e12 took 52 s of Stage II at
   // --grid 512 with it.)
+  auto reach_of = [&](double len) { return len * (1 + 0x1p-48) + 0x1p-49 * (boxes.magnitude + sg.extent); };
   std::vector<double> reach(n);
-  for (size_t i = 0; i < n; ++i) reach[i] = band_len[i] * (1 + 0x1p-48) + 0x1p-49 * (boxes.magnitude + sg.extent);
+  for (size_t i = 0; i < n; ++i) reach[i] = reach_of(band_len[i]);
+  // Which triangles are sampled: those within near_len of another object's triangle box, where
+  // near_len = U_i + 2 * slack (or the band, when that is shorter). A triangle farther than
+  // that from every other object is never part of a pair Stage III tests (its bound is at most
+  // D_u + slack <= U_i + slack), so it gets D_l = near_len, which culls it, without a sample;
+  // and no sample of it could lower D_u (a voxel whose SD~ + δ is below U_i touches a triangle
+  // within U_i of another object).
+  std::vector<double> near_len(n), near_reach(n);
+  for (size_t i = 0; i < n; ++i) {
+    near_len[i] = std::min(stage1.upper_bound[i] + 2 * slack, band_len[i]);
+    near_reach[i] = reach_of(near_len[i]);
+  }
 
   // A sample point farther than its band from every other object gets the band back: the
   // backend's walk there finds nothing. So only where another object's triangle boxes come
@@ -201,12 +213,11 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
     auto within = [&](const AABB& box, size_t j, double d) {
       return box_distance_squared(box, boxes.objects[j]) <= d * d && boxes.bvh(j).any_within(box, d);
     };
-    const double r = reach[i];
     // Near few objects, through their triangle hierarchies; near many (a container, a floor),
     // through the owner grid, whose cells are coarser but cost the same whatever the count.
     const bool crowded = near[i].size() > kFewNearObjects;
     // Whether another object's triangle box lies within reach of `box`.
-    auto other_within = [&](const AABB& box) {
+    auto other_within = [&](const AABB& box, double r) {
       return crowded ? owners->other_within(box, r, static_cast<Index>(i))
                      : std::any_of(near[i].begin(), near[i].end(), [&](Index j) { return within(box, static_cast<size_t>(j), r); });
     };
@@ -214,7 +225,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
     // D_u, and with a band of δ (+ slack) a sample culls one of its triangles only where nothing
     // lies within δ of the voxel centre, which saves few exact tests (Stage III then looks only
     // at touching boxes). So its triangles near another object are not sampled and stay
-    // uncullable (D_l = -inf); the others get the band as before. See README, "Stage II".
+    // uncullable (D_l = -inf); the others get near_len as above. See README, "Stage II".
     const bool touching = stage1.upper_bound[i] == 0;
     // Whether a voxel's centre lies within reach of another object's triangle box, against all
     // of near[i]: the answer does not depend on the triangle, so it is found once per voxel
@@ -234,14 +245,14 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
       }
       AABB centre;
       centre.lo = centre.hi = grid.center(id);
-      const bool keep = other_within(centre);
+      const bool keep = other_within(centre, reach[i]);
       if (m) *m = keep ? 1 : 2;
       return keep;
     };
     for (Index t = 0; t < o.num_triangles(); ++t) {
       const AABB& bt = boxes.triangles[i][static_cast<size_t>(t)];
-      if (!other_within(bt)) {
-        lower[static_cast<size_t>(t)] = band_len[i];
+      if (!other_within(bt, near_reach[i])) {
+        lower[static_cast<size_t>(t)] = near_len[i];
         continue;
       }
       if (touching) continue;
