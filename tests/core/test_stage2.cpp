@@ -170,6 +170,14 @@ TEST(Stage2, OnlyTrianglesNearAnotherObjectAreSampled) {
     const double near_voxels = (reach / cell + Vec3::Ones()).prod();
     EXPECT_LE(static_cast<double>(vb.sample_voxels), near_voxels);
     EXPECT_LT(vb.sampled_triangles, static_cast<std::uint64_t>(frame.objects[0].num_triangles() / 4));
+    // Sampled: only triangles within min(U_i, band) (+ rounding) of the other object, not all
+    // within the band (U_i + δ).
+    std::uint64_t within_u = 0;
+    for (size_t i = 0; i < 2; ++i) {
+      const double r = std::min(stage1.upper_bound[i], kMaxInterBandCells * cell) * 1.01 + 1e-9;
+      for (const AABB& bt : boxes.triangles[i]) within_u += box_distance_squared(bt, boxes.objects[1 - i]) <= r * r;
+    }
+    EXPECT_LE(vb.sampled_triangles, within_u);
     // The backend gets the blob and the sheet's triangles near it only (in bins of 4 cells
     // around the samples: at grid 16 a quarter of the sheet's bins).
     const auto blob = static_cast<std::uint64_t>(frame.objects[1].num_triangles());
