@@ -95,24 +95,29 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
   std::int64_t total_tris = 0;
   AABB scene;
   // Objects with fewer than 2 triangles have no non-adjacent pair: nothing to sample; nor are
-  // those the caller leaves out.
-  auto sampled_object = [&](size_t i) {
-    return frame.objects[i].num_triangles() >= 2 && !marked(skip, i);
-  };
+  // those the caller leaves out. The grid (its box, and the default resolution's triangle
+  // count and median size) is that of every object of 2 or more triangles, left out or not, so
+  // that it does not depend on which static objects' results the caller reuses: with them out
+  // of the box, funnel's frames after the first got cells of 0.023 instead of 0.054 at
+  // --grid 256, 4.5x the samples and 250 ms of self Stage II per frame instead of 29.
+  auto gridded_object = [&](size_t i) { return frame.objects[i].num_triangles() >= 2; };
+  auto sampled_object = [&](size_t i) { return gridded_object(i) && !marked(skip, i); };
+  bool any_sampled = false;
   for (size_t i = 0; i < n; ++i) {
     out.triangle_lower[i].assign(static_cast<size_t>(frame.objects[i].num_triangles()), -kInfinity);
-    if (!sampled_object(i)) continue;
+    any_sampled = any_sampled || sampled_object(i);
+    if (!gridded_object(i)) continue;
     total_tris += frame.objects[i].num_triangles();
     scene.extend(boxes.objects[i]);
   }
-  if (scene.empty()) return out;
+  if (!any_sampled || scene.empty()) return out;
 
   int res = grid_resolution;
   if (res <= 0) {
     std::vector<double> size;
     size.reserve(static_cast<size_t>(total_tris));
     for (size_t i = 0; i < n; ++i) {
-      if (!sampled_object(i)) continue;
+      if (!gridded_object(i)) continue;
       for (const AABB& b : boxes.triangles[i]) size.push_back((b.hi - b.lo).maxCoeff());
     }
     auto mid = size.begin() + static_cast<std::ptrdiff_t>(size.size() / 2);

@@ -90,7 +90,8 @@ int default_self_grid_resolution(std::int64_t triangles, double longest, double 
 /// intra_distance.hpp): it sets each triangle's band, and a triangle whose 2-ring bound is at
 /// most δ is not sampled (Stage II cannot lower its D_u; it keeps D_l = -inf).
 /// `grid_resolution` <= 0 picks default_self_grid_resolution(). Objects that `skip` marks (1)
-/// are left out like those of fewer than 2 triangles: not sampled, not in the grid's box.
+/// are not sampled, but the grid covers them as it would without `skip` (it depends on the
+/// frame alone); objects of fewer than 2 triangles are neither sampled nor in the grid.
 SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes,
                                               const std::vector<std::vector<double>>& ring2_bound,
                                               SelfVoronoiBackend& backend, int grid_resolution,

@@ -36,8 +36,8 @@ struct VoronoiBounds {
   /// D_l(f) = SD~(f) - δ per triangle: f is at least this far from every other object.
   std::vector<std::vector<double>> triangle_lower;
   std::uint64_t sample_voxels = 0;
-  /// Triangles with samples: those whose box lies within their object's band of another
-  /// object's triangle box (the others get D_l = band without a sample).
+  /// Triangles with samples: those whose box lies within min(U_i + 2 slack, band) of another
+  /// object's triangle box (the others get that as D_l without a sample).
   std::uint64_t sampled_triangles = 0;
   /// Triangles passed to the backend: those some sample's walk can reach (reachable_triangles()).
   std::uint64_t backend_triangles = 0;

@@ -314,6 +314,51 @@ TEST(IntraStage2, DefaultGridFollowsTheMedianTriangleInCrowds) {
   expect_same_intra(intra_object_distance(frame, boxes, ring2, IntraDistanceOptions{2, &vb}), ref, "crowd, default grid");
 }
 
+// The self grid depends on the frame alone, not on which objects the caller leaves out (static
+// objects whose results it reuses): a large object left out still sets the box, the default
+// resolution's triangle count and its median size, so the other objects get the same grid,
+// the same samples and the same bounds as when nothing is left out. (With the object out of
+// the box, funnel's frames after the first were sampled at cells of 0.023 instead of 0.054
+// at --grid 256.)
+TEST(IntraStage2, ObjectsLeftOutStillSetTheGrid) {
+  Rng rng(11);
+  Frame frame;
+  frame.objects.push_back(test::make_blob(rng, Vec3(0, 0, 0), 4.0, 2, 0.1, "container"));
+  frame.objects.push_back(test::make_blob(rng, Vec3(0.5, 0.2, 0), 0.6, 2, 0.4, "a"));
+  frame.objects.push_back(test::make_blob(rng, Vec3(-0.8, 0.3, 0.2), 0.5, 1, 0.4, "b"));
+  const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
+  const std::vector<std::uint8_t> skip = {1, 0, 0};
+  const auto ring2_all = ring2_upper_bounds(frame, 2);
+  const auto ring2_skip = ring2_upper_bounds(frame, 2, &skip);
+  auto backend = make_cpu_self_voronoi_backend(2);
+  for (int grid : {0, 48, 160}) {
+    SCOPED_TRACE("grid " + std::to_string(grid));
+    const SelfVoronoiBounds all = compute_self_voronoi_bounds(frame, boxes, ring2_all, *backend, grid, 2);
+    const SelfVoronoiBounds part = compute_self_voronoi_bounds(frame, boxes, ring2_skip, *backend, grid, 2, &skip);
+    EXPECT_EQ(part.grid.dims, all.grid.dims);
+    EXPECT_EQ(part.grid.cell, all.grid.cell);
+    EXPECT_EQ(part.delta, all.delta);
+    for (size_t i = 1; i < 3; ++i) {
+      EXPECT_EQ(part.triangle_lower[i], all.triangle_lower[i]) << "object " << i;
+      EXPECT_EQ(part.triangle_upper[i], all.triangle_upper[i]) << "object " << i;
+    }
+    // The container is not sampled: no bound of its triangles changes.
+    for (double v : part.triangle_lower[0]) EXPECT_EQ(v, -kInfinity);
+    EXPECT_LE(part.sampled_triangles, all.sampled_triangles);
+    EXPECT_GT(part.sampled_triangles, 0u);
+    const auto ref = intra_object_distance_brute_force(frame);
+    IntraDistanceOptions opts{2, &part, &skip};
+    const auto got = intra_object_distance(frame, boxes, ring2_skip, opts);
+    for (size_t i = 1; i < 3; ++i) {
+      ASSERT_EQ(got.per_object[i].per_triangle.size(), ref.per_object[i].per_triangle.size());
+      for (size_t t = 0; t < ref.per_object[i].per_triangle.size(); ++t) {
+        EXPECT_EQ(got.per_object[i].per_triangle[t].distance, ref.per_object[i].per_triangle[t].distance);
+        EXPECT_EQ(got.per_object[i].per_triangle[t].nearest, ref.per_object[i].per_triangle[t].nearest);
+      }
+    }
+  }
+}
+
 // Only triangles whose 2-ring bound exceeds 2δ get samples (kSelfSampleRing2OverDelta: below
 // δ Stage II cannot lower their D_u, and up to 2δ it rarely gains anything), and that have a
 // non-adjacent triangle at all (not a tetrahedron's faces); the others keep D_u = 2-ring bound
