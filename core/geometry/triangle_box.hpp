@@ -7,6 +7,9 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <limits>
+#include <utility>
 
 namespace vproxq {
 
@@ -32,6 +35,34 @@ class TriangleBoxTester {
       if (s < lo_[a] || s > hi_[a]) return false;
     }
     return true;
+  }
+
+  /// On the row of cubes centred at (x, cy, cz), an interval [lo, hi] of x (lo > hi: empty)
+  /// outside which overlaps() is false. `magnitude` bounds every |coordinate| of the centres
+  /// and of the triangle. Each axis a bounds a.x * x to [lo_a - t, hi_a - t], t = a.y cy + a.z cz,
+  /// widened by 2^-40 (|a|_1 magnitude + |lo_a| + |hi_a|), far above the few ulps by which
+  /// overlaps()'s a · c and this t + a.x x can differ; an axis with a.x = 0 accepts or rejects
+  /// the whole row. The divisions round the interval's ends by an ulp of themselves: callers
+  /// widen it by a cube (voxelize_cells()).
+  std::pair<double, double> row_span(double cy, double cz, double magnitude) const {
+    double lo = -std::numeric_limits<double>::infinity(), hi = std::numeric_limits<double>::infinity();
+    for (size_t a = 0; a < kAxes; ++a) {
+      const Vec3& ax = axis_[a];
+      const double t = ax.y() * cy + ax.z() * cz;
+      const double m = 0x1p-40 * ((std::abs(ax.x()) + std::abs(ax.y()) + std::abs(ax.z())) * magnitude +
+                                  std::abs(lo_[a]) + std::abs(hi_[a]));
+      const double l = lo_[a] - t - m, h = hi_[a] - t + m;
+      if (ax.x() == 0) {
+        if (l > 0 || h < 0) return {1, 0};
+      } else if (ax.x() > 0) {
+        lo = std::max(lo, l / ax.x());
+        hi = std::min(hi, h / ax.x());
+      } else {
+        lo = std::max(lo, h / ax.x());
+        hi = std::min(hi, l / ax.x());
+      }
+    }
+    return {lo, hi};
   }
 
  private:

@@ -40,6 +40,8 @@ struct StageGrid {
   double unit = 1;
 
   static constexpr double kVoxelSlackRel = 1e-9;
+  /// voxelize_cells() finds the span of rows of more than this many cells.
+  static constexpr std::int32_t kRowSpanCells = 3;
 
   /// Cubic cells, `resolution` (>= 1) cells along the longest axis of the non-empty `box`.
   static StageGrid over(const AABB& box, int resolution) {
@@ -123,13 +125,36 @@ struct StageGrid {
     for (auto& p : rel) p -= grid.origin;
     const auto [lo, hi] = cell_range(box);
     const TriangleBoxTester tester(rel, half);
+    // Per row of cells along x, only the cells within the row's span (row_span(), widened by a
+    // cell on each side) are tested: on fine grids a triangle's box holds some cells per side,
+    // and testing all of its cells cost the cube of that (skirt at --grid 1024: the inter- and
+    // intra-object setups took 3.2 and 3.3 s per frame, 0.7 and 0.8 s this way). The cells
+    // visited are the same: those that overlaps() accepts.
+    // Rows shorter than kRowSpanCells + 1 cells are tested whole: finding the span costs more
+    // than it saves there (blobs-200 at its default grid, triangles of 1-2 cells: +7% setup).
+    double magnitude = extent + 2 * grid.cell;
+    for (const auto& p : rel) magnitude = std::max(magnitude, p.cwiseAbs().maxCoeff());
     for (std::int32_t z = lo[2]; z <= hi[2]; ++z)
-      for (std::int32_t y = lo[1]; y <= hi[1]; ++y)
-        for (std::int32_t x = lo[0]; x <= hi[0]; ++x) {
+      for (std::int32_t y = lo[1]; y <= hi[1]; ++y) {
+        const double cy = grid.cell * (y + 0.5), cz = grid.cell * (z + 0.5);
+        std::int32_t first = lo[0], last = hi[0];
+        if (last - first >= kRowSpanCells) {
+          const auto [slo, shi] = tester.row_span(cy, cz, magnitude);
+          if (!(slo <= shi)) continue;
+          // Centre x of cell X is cell * (X + 1/2): the cells whose centres lie in the span,
+          // one more on each side, clamped (in double: the span may be infinite) to the box's.
+          const double f = std::max(std::ceil(slo / grid.cell - 0.5) - 1, static_cast<double>(lo[0]));
+          const double l = std::min(std::floor(shi / grid.cell - 0.5) + 1, static_cast<double>(hi[0]));
+          if (f > l) continue;
+          first = static_cast<std::int32_t>(f);
+          last = static_cast<std::int32_t>(l);
+        }
+        for (std::int32_t x = first; x <= last; ++x) {
           const Vec3 c = grid.cell * Vec3(x + 0.5, y + 0.5, z + 0.5);
           if (!tester.overlaps(c)) continue;
           visit(Cell{x, y, z}, x + std::int64_t{grid.dims[0]} * (y + std::int64_t{grid.dims[1]} * z));
         }
+      }
   }
 };
 
