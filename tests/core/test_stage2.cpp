@@ -322,11 +322,48 @@ TEST(Stage2, GridHasExactlyTheRequestedCellsAlongTheLongestAxis) {
   }
 }
 
+/// Triangle number i of the voxelization tests, in `scene` (whose grid is g): of every shape,
+/// by i % 5: ordinary, a sliver, exactly collinear, a single point, or lying in a grid plane
+/// with a corner on a voxel corner; by i % 3 about 0.3, 2.5 or 12 cells across.
+Triangle voxelization_test_triangle(test::Rng& rng, const AABB& scene, const VoronoiGrid& g, int i) {
+  auto random_point = [&](const Vec3& around, double r) {
+    Vec3 p;
+    for (int k = 0; k < 3; ++k)
+      p[k] = std::clamp(around[k] + rng.uniform(-r, r), scene.lo[k], scene.lo[k] + g.cell * g.dims[k]);
+    return p;
+  };
+  const Vec3 centre = random_point(0.5 * (scene.lo + scene.hi), 0.5 * (scene.hi - scene.lo).maxCoeff());
+  const double size = g.cell * (i % 3 == 0 ? 0.3 : i % 3 == 1 ? 2.5 : 12.0);
+  Triangle tri{random_point(centre, size), random_point(centre, size), random_point(centre, size)};
+  switch (i % 5) {
+    case 1:  // sliver: the third corner almost on the first edge
+      tri[2] = tri[0] + 0.37 * (tri[1] - tri[0]) + Vec3::Constant(1e-9 * g.cell);
+      break;
+    case 2:  // exactly collinear
+      tri[2] = 0.5 * (tri[0] + tri[1]);
+      break;
+    case 3:  // a point
+      tri[1] = tri[2] = tri[0];
+      break;
+    case 4: {  // in a grid plane, corners on voxel boundaries
+      const int axis = i % 3;
+      const double plane = scene.lo[axis] + g.cell * std::floor(g.dims[static_cast<size_t>(axis)] * rng.uniform(0, 1));
+      for (Vec3& p : tri) p[axis] = plane;
+      tri[0] = scene.lo + g.cell * Vec3(std::floor((tri[0] - scene.lo).x() / g.cell),
+                                        std::floor((tri[0] - scene.lo).y() / g.cell),
+                                        std::floor((tri[0] - scene.lo).z() / g.cell));
+      break;
+    }
+    default:
+      break;
+  }
+  return tri;
+}
+
 // The voxelization Lemma 2 rests on (StageGrid::voxelize): every voxel holding a point of the
 // triangle is marked (checked at the corners and on a barycentric lattice), and every marked
 // voxel's centre is within sqrt(3) * half of the triangle (so within δ). Triangles of every
-// shape: ordinary, slivers, exactly collinear, single points, and triangles lying in a grid
-// plane (coordinates on voxel boundaries), small and large against the cell.
+// shape (voxelization_test_triangle()), small and large against the cell.
 TEST(Stage2, VoxelizationMarksEveryTouchedVoxelAndOnlyNearOnes) {
   test::Rng rng(11);
   AABB scene;
@@ -334,39 +371,9 @@ TEST(Stage2, VoxelizationMarksEveryTouchedVoxelAndOnlyNearOnes) {
   scene.extend(Vec3(3.0, 2.0, 1.5));
   const StageGrid sg = StageGrid::over(scene, 23);
   const VoronoiGrid& g = sg.grid;
-  auto random_point = [&](const Vec3& around, double r) {
-    Vec3 p;
-    for (int k = 0; k < 3; ++k)
-      p[k] = std::clamp(around[k] + rng.uniform(-r, r), scene.lo[k], scene.lo[k] + g.cell * g.dims[k]);
-    return p;
-  };
   std::uint64_t marked_total = 0, checked_points = 0;
   for (int i = 0; i < 4000; ++i) {
-    const Vec3 centre = random_point(0.5 * (scene.lo + scene.hi), 2.0);
-    const double size = g.cell * (i % 3 == 0 ? 0.3 : i % 3 == 1 ? 2.5 : 12.0);
-    Triangle tri{random_point(centre, size), random_point(centre, size), random_point(centre, size)};
-    switch (i % 5) {
-      case 1:  // sliver: the third corner almost on the first edge
-        tri[2] = tri[0] + 0.37 * (tri[1] - tri[0]) + Vec3::Constant(1e-9 * g.cell);
-        break;
-      case 2:  // exactly collinear
-        tri[2] = 0.5 * (tri[0] + tri[1]);
-        break;
-      case 3:  // a point
-        tri[1] = tri[2] = tri[0];
-        break;
-      case 4: {  // in a grid plane, corners on voxel boundaries
-        const int axis = i % 3;
-        const double plane = scene.lo[axis] + g.cell * std::floor(g.dims[static_cast<size_t>(axis)] * rng.uniform(0, 1));
-        for (Vec3& p : tri) p[axis] = plane;
-        tri[0] = scene.lo + g.cell * Vec3(std::floor((tri[0] - scene.lo).x() / g.cell),
-                                          std::floor((tri[0] - scene.lo).y() / g.cell),
-                                          std::floor((tri[0] - scene.lo).z() / g.cell));
-        break;
-      }
-      default:
-        break;
-    }
+    const Triangle tri = voxelization_test_triangle(rng, scene, g, i);
     AABB box;
     for (const Vec3& p : tri) box.extend(p);
     std::vector<std::int64_t> marked;
@@ -403,6 +410,45 @@ TEST(Stage2, VoxelizationMarksEveryTouchedVoxelAndOnlyNearOnes) {
   // The triangles are not all tiny: the lattices and voxel lists are substantial.
   EXPECT_GT(marked_total, 50000u);
   EXPECT_GT(checked_points, 1000000u);
+}
+
+// voxelize_cells() tests only the cells of each row within the triangle's span along it; it
+// must visit exactly the cells of the triangle's box range that the separating-axis test
+// accepts, as testing every cell of the range does, in the same order. Scenes near and far
+// from the origin, coarse and fine grids, triangles of every shape.
+TEST(Stage2, VoxelizationVisitsWhatTestingEveryCellOfTheBoxFinds) {
+  test::Rng rng(12);
+  std::uint64_t visited_total = 0;
+  for (const double offset : {0.0, -3.5e4, 1e9})
+    for (const int res : {23, 160, 1024}) {
+      AABB scene;
+      scene.extend(Vec3(-1.0, -2.0, -0.5) + Vec3::Constant(offset));
+      scene.extend(Vec3(3.0, 2.0, 1.5) + Vec3::Constant(offset));
+      const StageGrid sg = StageGrid::over(scene, res);
+      const VoronoiGrid& g = sg.grid;
+      for (int i = 0; i < 1500; ++i) {
+        const Triangle tri = voxelization_test_triangle(rng, scene, g, i);
+        AABB box;
+        for (const Vec3& p : tri) box.extend(p);
+        std::vector<std::int64_t> visited, expected;
+        sg.voxelize_cells(tri, box, [&](const StageGrid::Cell& c, std::int64_t id) {
+          ASSERT_EQ(id, c[0] + std::int64_t{g.dims[0]} * (c[1] + std::int64_t{g.dims[1]} * c[2]));
+          visited.push_back(id);
+        });
+        Triangle rel = tri;
+        for (Vec3& p : rel) p -= g.origin;
+        const TriangleBoxTester tester(rel, sg.half);
+        const auto [lo, hi] = sg.cell_range(box);
+        for (std::int32_t z = lo[2]; z <= hi[2]; ++z)
+          for (std::int32_t y = lo[1]; y <= hi[1]; ++y)
+            for (std::int32_t x = lo[0]; x <= hi[0]; ++x)
+              if (tester.overlaps(g.cell * Vec3(x + 0.5, y + 0.5, z + 0.5)))
+                expected.push_back(x + std::int64_t{g.dims[0]} * (y + std::int64_t{g.dims[1]} * z));
+        ASSERT_EQ(visited, expected) << "offset " << offset << ", grid " << res << ", triangle " << i;
+        visited_total += visited.size();
+      }
+    }
+  EXPECT_GT(visited_total, 200000u);
 }
 
 }  // namespace
