@@ -143,10 +143,12 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   const double slack = rounding_slack(boxes.magnitude);
 
   // Bands: object i needs exact values up to U_i + δ (+ slack) so that its capped triangles
-  // are culled (D_l = band - δ > D_u); capped at kMaxInterBandCells cells.
+  // are culled (D_l = band - δ > D_u); capped at kMaxInterBandCells cells of this grid or of
+  // the default one, the larger: finer grids keep the default grid's band in scene units.
   std::vector<double> band_len(n);
+  out.band_cap = kMaxInterBandCells * std::max(grid.cell, StageGrid::over(scene, default_grid_resolution(total_tris)).grid.cell);
   for (size_t i = 0; i < n; ++i)
-    band_len[i] = std::min(stage1.upper_bound[i] + out.delta + slack, kMaxInterBandCells * grid.cell);
+    band_len[i] = std::min(stage1.upper_bound[i] + out.delta + slack, out.band_cap);
   // The sampling filter's tests below reach a little past the band, so that rounding cannot
   // skip what lies within it: a voxel centre (origin + cell * (index + 1/2)) is within
   // 2^-52 (M + E) of its exact value per coordinate (M: largest coordinate magnitude, E: grid

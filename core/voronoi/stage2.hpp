@@ -10,16 +10,22 @@
 
 namespace vproxq {
 
-/// Bands are capped at this many cells: a narrower band only weakens culling, never
-/// correctness (values at the cap give D_l = cap - δ, which culls only where D_u fell below
-/// cap - δ). A capped band culls where the object's SD~ + 2δ (δ ~ 0.87 cell) lies below it, so
-/// 2 cells keep the culling of objects nearer than ~0.27 cell to another, 3 cells that of
-/// objects up to ~1.27 cells away. Measured (cpu backend, 2 threads), 3 -> 2 cells: the
+/// Bands are capped at this many cells of the grid, or of the default grid
+/// (default_grid_resolution()) where those are larger: a narrower band only weakens culling,
+/// never correctness (values at the cap give D_l = cap - δ, which culls only where D_u fell
+/// below cap - δ). A capped band culls where the object's SD~ + 2δ (δ ~ 0.87 cell) lies below
+/// it, so 2 cells keep the culling of objects nearer than ~0.27 cell to another, 3 cells that
+/// of objects up to ~1.27 cells away. Measured (cpu backend, 2 threads), 3 -> 2 cells: the
 /// 200-object scene's inter-object distance 31-34 -> 23-26 ms per frame (two runs each,
 /// bench.sh's frames, best of 5) with 0.9% more exact tests on frame 2 and the same on the
 /// others; the report scenes' frames 10-15, exact tests +6% on skirt (2,262 -> 2,392 per
 /// frame), +1% on funnel, the same on cloth-ball and breaking, and Stage II 5-10% faster
 /// (skirt's query time within its run-to-run spread). 1.5 cells: 20-22 ms, skirt +37%.
+/// On grids finer than the default, a cap of 2 of their own cells shrank the band in scene
+/// units until it culled nothing: skirt's frames 10-12 had 2,743 / 5,443 / 8,948 inter-object
+/// exact tests per frame at --grid 128 / 256 / 512 (off: 9,530); with 2 default cells (the
+/// default grid has 92 cells there) 2,292 / 1,428 / 778, for 26 / 116 / 968 ms of Stage II
+/// instead of 22 / 59 / 208 (see README, "Stage II").
 inline constexpr double kMaxInterBandCells = 2.0;
 
 /// Grid resolution used when none is given: 4 * cbrt(triangles), clamped to [32, 256] cells
@@ -30,6 +36,8 @@ struct VoronoiBounds {
   VoronoiGrid grid;
   double delta = 0;            ///< δ = (cell diagonal)/2 + voxelization slack + δ_precision
   double delta_precision = 0;  ///< the backend's float error bound for this grid
+  /// The bands' cap: kMaxInterBandCells cells of the grid or of the default grid, the larger.
+  double band_cap = 0;
   /// D_u(O_i) = min(Stage I bound, SD~(O_i) + δ): the separation distance of object i is at
   /// most this.
   std::vector<double> object_upper;

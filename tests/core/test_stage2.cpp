@@ -158,15 +158,15 @@ TEST(Stage2, OnlyTrianglesNearAnotherObjectAreSampled) {
   const ObjectBroadPhase stage1 = object_broad_phase(frame, boxes, 2);
   auto backend = make_cpu_voronoi_backend(2);
   const auto ref = inter_object_distance_brute_force(frame);
-  // Grids at which the band (at most kMaxInterBandCells cells) reaches from the blob to the
-  // sheet, about 0.1 below it (at 200 cells, 2 cells are 0.1: nothing is sampled).
+  // Grids at which the band (at most band_cap: kMaxInterBandCells cells of the grid or of the
+  // default grid) reaches from the blob to the sheet, about 0.1 below it.
   for (int grid : {16, 64, 120}) {
     SCOPED_TRACE("grid " + std::to_string(grid));
     const VoronoiBounds vb = compute_voronoi_bounds(frame, boxes, stage1, *backend, grid, 2);
     const double cell = vb.grid.cell;
-    // The sample voxels lie within the band (<= kMaxInterBandCells cells) of the blob's box, plus the sheet's
+    // The sample voxels lie within the band (<= band_cap) of the blob's box, plus the sheet's
     // triangles' voxels around it: at most this many.
-    const Vec3 reach = boxes.objects[1].hi - boxes.objects[1].lo + Vec3::Constant(2 * 4 * cell);
+    const Vec3 reach = boxes.objects[1].hi - boxes.objects[1].lo + Vec3::Constant(2 * (vb.band_cap + 2 * cell));
     const double near_voxels = (reach / cell + Vec3::Ones()).prod();
     EXPECT_LE(static_cast<double>(vb.sample_voxels), near_voxels);
     EXPECT_LT(vb.sampled_triangles, static_cast<std::uint64_t>(frame.objects[0].num_triangles() / 4));
@@ -174,7 +174,7 @@ TEST(Stage2, OnlyTrianglesNearAnotherObjectAreSampled) {
     // within the band (U_i + δ).
     std::uint64_t within_u = 0;
     for (size_t i = 0; i < 2; ++i) {
-      const double r = std::min(stage1.upper_bound[i], kMaxInterBandCells * cell) * 1.01 + 1e-9;
+      const double r = std::min(stage1.upper_bound[i], vb.band_cap) * 1.01 + 1e-9;
       for (const AABB& bt : boxes.triangles[i]) within_u += box_distance_squared(bt, boxes.objects[1 - i]) <= r * r;
     }
     EXPECT_LE(vb.sampled_triangles, within_u);
@@ -183,7 +183,7 @@ TEST(Stage2, OnlyTrianglesNearAnotherObjectAreSampled) {
     const auto blob = static_cast<std::uint64_t>(frame.objects[1].num_triangles());
     ASSERT_GE(vb.backend_triangles, blob);
     EXPECT_LT(vb.backend_triangles - blob, static_cast<std::uint64_t>(frame.objects[0].num_triangles() / 2));
-    const double near0 = std::min(stage1.upper_bound[0], kMaxInterBandCells * cell);
+    const double near0 = std::min(stage1.upper_bound[0], vb.band_cap);
     Index far = 0;
     for (size_t i = 0; i < 2; ++i) {
       EXPECT_GE(vb.object_upper[i], ref.per_object[i].distance);
@@ -204,6 +204,29 @@ TEST(Stage2, OnlyTrianglesNearAnotherObjectAreSampled) {
       EXPECT_EQ(got.per_object[i].triangles, ref.per_object[i].triangles);
     }
   }
+}
+
+// On grids finer than the default, the band's cap stays 2 cells of the default grid in scene
+// units (VoronoiBounds::band_cap): capped at 2 of their own cells it shrank below the gap
+// between objects, and no triangle could be culled. A blob 0.3 above a sheet (default grid 42
+// cells of 0.24): at 200 and 400 cells, 2 cells (0.1, 0.05) are less than the gap, so no
+// sheet triangle got a D_l above the answer (0 of 1,152); now those farther than the answer +
+// 2δ from the blob do (1,146), which culls them.
+TEST(Stage2, FineGridsKeepTheDefaultGridsBand) {
+  test::Rng rng(9);
+  Frame frame;
+  frame.objects.push_back(make_sheet(24, 10.0, "sheet"));
+  frame.objects.push_back(test::make_blob(rng, Vec3(5.0, 5.0, 0.55), 0.25, 1, 0.02, "blob"));
+  const double answer = inter_object_distance_brute_force(frame).per_object[0].distance;
+  ASSERT_GT(answer, 0.2);
+  ASSERT_LT(answer, 0.4);
+  const auto sheet = static_cast<std::uint64_t>(frame.objects[0].num_triangles());
+  expect_bounds_at_grids(frame, {200, 400}, "blob over a sheet", [&](const VoronoiBounds& vb) {
+    EXPECT_GT(vb.band_cap, 2 * vb.grid.cell);
+    std::uint64_t culled = 0;
+    for (const double lower : vb.triangle_lower[0]) culled += lower > answer;
+    EXPECT_GT(culled, sheet * 9 / 10);
+  });
 }
 
 // The same bounds on crowds where most triangles have another object within the band: blobs,
@@ -272,14 +295,17 @@ TEST(Stage2, SamplesFarFromTheOriginAboutWhatTheyDoAtIt) {
       vb[static_cast<size_t>(k)] = compute_voronoi_bounds(frame, boxes, stage1, *backend, grid, 2);
     }
     EXPECT_GT(vb[0].sample_voxels, 0u);
-    EXPECT_LE(vb[1].sample_voxels, 2 * vb[0].sample_voxels);
+    // Far from the origin the triangles within the band are sampled, not only those within
+    // U_i (below): at grid 128 (band_cap: 2 cells of the default grid, 7.3 of its own) that
+    // is 2.1x the voxels.
+    EXPECT_LE(vb[1].sample_voxels, 3 * vb[0].sample_voxels);
     // Near the origin only triangles within U_i of another object are sampled; far from it the
     // rounding slack (~110 at 2^40) widens that to the band, but no farther: at most the
     // triangles whose boxes lie within the band's cap of another object's triangle box, plus
     // the owner grid's coarseness (cells of two voxels: a widened box's cells reach up to a
     // cell's diagonal farther).
     const FrameBoxes boxes = FrameBoxes::compute(near_origin, 2);
-    const double cap = (kMaxInterBandCells + 2 * std::sqrt(3.0)) * vb[0].grid.cell * 1.01;
+    const double cap = (vb[0].band_cap + 2 * std::sqrt(3.0) * vb[0].grid.cell) * 1.01;
     std::uint64_t within_cap = 0;
     for (size_t i = 0; i < near_origin.objects.size(); ++i)
       for (const AABB& bt : boxes.triangles[i]) {
