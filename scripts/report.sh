@@ -32,8 +32,9 @@
 #   REPEAT       1                   FCL bench: runs per frame, fastest kept
 #   PNS          1                   0: skip vproxq-bench-pns (exact tests against their floor
 #                                    and the paper's fixed-bound PNS, same frames as RANGE)
-#   GRID_SCENES  funnel              scenes of the grid sweep (the paper's figure 14 used its
-#                                    200-object scene); "" skips the sweep
+#   GRID_SCENES  "funnel skirt"      scenes of the grid sweep (the paper's figure 14 used its
+#                                    200-object scene; skirt's exact tests fall with the grid,
+#                                    funnel's stay near their floor); "" skips the sweep
 #   GRIDS        "32 48 64 96 128 192 256"   --grid values of the sweep (--voronoi=GRID_MODE)
 #   GRID_RANGE   (all)               --frames A:B of the sweep runs
 #   OUT          bench-out/report    report folder (its runs/ is replaced)
@@ -55,7 +56,7 @@ threads=${THREADS:-2}
 fcl=${FCL:-1}
 pns=${PNS:-1}
 repeat=${REPEAT:-1}
-grid_scenes=${GRID_SCENES-funnel}
+grid_scenes=${GRID_SCENES-funnel skirt}
 grids=${GRIDS:-32 48 64 96 128 192 256}
 grid_range=${GRID_RANGE:-}
 out=${OUT:-bench-out/report}
