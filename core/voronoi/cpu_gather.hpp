@@ -147,6 +147,8 @@ void for_each_nearest_first(const DvdInput& in, const Vec3& q,
       visit_run(first, last);
       return;
     }
+    // A bin holding only skipped triangles (ascending: its first and last say so) or none.
+    if (first == last || (*first >= skip.lo && last[-1] < skip.hi)) return;
     const std::int32_t* s0 = std::lower_bound(first, last, skip.lo);
     visit_run(first, s0);
     visit_run(std::lower_bound(s0, last, skip.hi), last);
