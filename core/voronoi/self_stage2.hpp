@@ -72,8 +72,10 @@ struct SelfVoronoiBounds {
   /// [object][triangle] D_l(f) = SD~(f) - δ (a capped sample counts as its band).
   std::vector<std::vector<double>> triangle_lower;
   std::uint64_t samples = 0;        ///< (voxel, triangle) pairs evaluated
-  std::uint64_t sampled_triangles = 0;  ///< triangles with samples: those whose 2-ring bound exceeds δ
-  std::uint64_t sample_voxels = 0;  ///< distinct voxels among them
+  /// Triangles with samples: those whose 2-ring bound exceeds kSelfSampleRing2OverDelta δ and
+  /// that have a non-adjacent triangle.
+  std::uint64_t sampled_triangles = 0;
+  std::uint64_t sample_voxels = 0;  ///< distinct voxels among the samples
   /// Triangles passed to the backend: the sampled ones and those of their objects that some
   /// sample's walk can reach (reachable_triangles()).
   std::uint64_t backend_triangles = 0;
@@ -81,14 +83,15 @@ struct SelfVoronoiBounds {
 };
 
 /// Grid resolution for the self query when none is given (see self_stage2.cpp): sqrt(n)
-/// cells along the longest axis (`longest`, of the sampled objects' box), but cells no
-/// smaller than 0.7 times `median_size` (the median triangle box's longest side), clamped to
-/// [32, 512].
+/// cells along the longest axis (`longest`, of the box of the objects of 2 or more triangles,
+/// left out or not), but cells no smaller than 0.7 times `median_size` (the median triangle
+/// box's longest side), clamped to [32, 512].
 int default_self_grid_resolution(std::int64_t triangles, double longest, double median_size);
 
 /// Runs the self Stage II on a frame. `ring2_bound` is ring2_upper_bounds(frame) (query/
 /// intra_distance.hpp): it sets each triangle's band, and a triangle whose 2-ring bound is at
-/// most δ is not sampled (Stage II cannot lower its D_u; it keeps D_l = -inf).
+/// most kSelfSampleRing2OverDelta δ is not sampled (it keeps D_u = its 2-ring bound and
+/// D_l = -inf).
 /// `grid_resolution` <= 0 picks default_self_grid_resolution(). Objects that `skip` marks (1)
 /// are not sampled, but the grid covers them as it would without `skip` (it depends on the
 /// frame alone); objects of fewer than 2 triangles are neither sampled nor in the grid.

@@ -134,7 +134,8 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   if (scene.empty()) return out;
 
   // Grid: cubic cells, `res` cells along the longest axis.
-  const int res = grid_resolution > 0 ? grid_resolution : default_grid_resolution(total_tris);
+  const int default_res = default_grid_resolution(total_tris);
+  const int res = grid_resolution > 0 ? grid_resolution : default_res;
   const StageGrid sg = StageGrid::over(scene, res);
   VoronoiGrid& grid = out.grid;
   grid = sg.grid;
@@ -146,7 +147,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   // are culled (D_l = band - δ > D_u); capped at kMaxInterBandCells cells of this grid or of
   // the default one, the larger: finer grids keep the default grid's band in scene units.
   std::vector<double> band_len(n);
-  out.band_cap = kMaxInterBandCells * std::max(grid.cell, StageGrid::over(scene, default_grid_resolution(total_tris)).grid.cell);
+  out.band_cap = kMaxInterBandCells * std::max(grid.cell, StageGrid::over(scene, default_res).grid.cell);
   for (size_t i = 0; i < n; ++i)
     band_len[i] = std::min(stage1.upper_bound[i] + out.delta + slack, out.band_cap);
   // The sampling filter's tests below reach a little past the band, so that rounding cannot
