@@ -18,8 +18,9 @@ namespace vproxq {
 namespace {
 
 // Voxelization and its slack: StageGrid (grid_setup.hpp), shared with the self Stage II.
-// Bins of this many voxels per side for the backends' triangle lookup (more on very fine
-// grids: bin_size_for()).
+// Bins of this many voxels per side for the backends' triangle lookup, at least: on grids
+// finer than the default one, bins of twice the band's cap (kBinSize cells of the default
+// grid), and more on very fine grids (bin_size_for()).
 constexpr std::int32_t kBinSize = 4;
 // Stage II's sampling filter asks each nearby object's triangle hierarchy while an object has
 // at most this many nearby objects, else the owner grid.
@@ -315,7 +316,16 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   // Triangles relative to the origin, in backend units, in object order: only those some
   // sample's walk can reach (reachable_triangles()). Most triangles of a frame are far from
   // every sample, and preparing them cost more than the samples did.
-  set_bin_layout(in, bin_size_for(in.grid, kBinSize));
+  // A sample's walk reaches its band (at most band_cap) around its voxel, so with bins of
+  // 2 band_cap it spans 2 or 3 bins per axis on every grid. Bins of kBinSize voxels of a grid
+  // finer than the default one made the walk cross more bins the finer the grid (skirt at
+  // --grid 512: 11 voxels of band, up to 7 bins per axis), each triangle listed in more of
+  // them: there the CPU walk took 706 ms per frame instead of 131 (frames 10-12). On the default grid and
+  // coarser ones, 2 band_cap is kBinSize cells (band_cap / cell is exactly 2: in.grid.cell is
+  // sg.grid.cell times a power of two).
+  const double cap_cells = out.band_cap / (sg.unit * in.grid.cell);
+  const auto bin_side = std::max(kBinSize, static_cast<std::int32_t>(std::lround(2 * cap_cells)));
+  set_bin_layout(in, bin_size_for(in.grid, bin_side));
   const std::vector<std::vector<Index>> kept = reachable_triangles(
       in, sg, boxes, threads, [](size_t) { return true; }, [](size_t, Index) { return false; });
   fill_dvd_triangles(in, frame, sg, kept);
