@@ -35,7 +35,7 @@
 #   GRID_SCENES  "funnel skirt"      scenes of the grid sweep (the paper's figure 14 used its
 #                                    200-object scene; skirt's exact tests fall with the grid,
 #                                    funnel's stay near their floor); "" skips the sweep
-#   GRIDS        "32 48 64 96 128 192 256"   --grid values of the sweep (--voronoi=GRID_MODE)
+#   GRIDS        "32 48 64 96 128 192 256 384 512"  --grid values of the sweep (--voronoi=GRID_MODE)
 #   GRID_RANGE   (all)               --frames A:B of the sweep runs
 #   OUT          bench-out/report    report folder (its runs/ is replaced)
 #   JOBS         2                   build jobs
@@ -57,7 +57,7 @@ fcl=${FCL:-1}
 pns=${PNS:-1}
 repeat=${REPEAT:-1}
 grid_scenes=${GRID_SCENES-funnel skirt}
-grids=${GRIDS:-32 48 64 96 128 192 256}
+grids=${GRIDS:-32 48 64 96 128 192 256 384 512}
 grid_range=${GRID_RANGE:-}
 out=${OUT:-bench-out/report}
 jobs=${JOBS:-2}
