@@ -111,9 +111,11 @@ inline SkippedTriangles site_triangles(const DvdInput& in, bool sorted, std::int
 /// Calls visit(t) for the triangles listed in the bins of `range`, bins in rings of increasing
 /// Chebyshev distance around the bin of q, each triangle at most once per `stamp` (`seen` holds
 /// the last stamp per triangle; it grows as needed; a stamp must never repeat). Stops before a
-/// ring all of whose points are farther from q than cutoff() (+ the relative slack below), so
-/// every triangle having a point within cutoff() of q is visited, whatever cutoff() returns
-/// while the walk goes on (it may only shrink). Triangles in `skip` are not visited: each
+/// ring all of whose points are farther from q than cutoff() (+ the relative slack below), and
+/// passes over a bin whose box is farther from q than cutoff() (+ a slack for the rounding of
+/// its bounds), so every triangle having a point within cutoff() of q is visited, whatever
+/// cutoff() returns while the walk goes on (it may only shrink): such a point lies in a bin
+/// that lists the triangle and is no farther from q. Triangles in `skip` are not visited: each
 /// bin's list is sorted (bins.cpp fills them in triangle order), so they are one run per bin,
 /// found by binary search instead of being stepped over one by one.
 template <typename Cutoff, typename Visit>
@@ -131,7 +133,26 @@ void for_each_nearest_first(const DvdInput& in, const Vec3& q,
   }
   // A bin r rings away is separated from q's bin by r - 1 whole bins along some axis.
   const double width = in.grid.cell * in.bin_size;
-  auto visit_bin = [&](std::int32_t bx, std::int32_t by, std::int32_t bz) {
+  // Bin b along an axis holds the coordinates x with floor(x / cell) / bin_size == b: up to the
+  // rounding of x / cell, [b width, (b + 1) width), the first and last bins unbounded (clamped
+  // coordinates). The computed bounds and gaps are within a few 2^-53 of (|q| + bin bounds) of
+  // their exact values, so widening the cut-off by 2^-40 of that never passes over a bin
+  // holding a point within cutoff() of q.
+  const double bound_slack = kBinSearchSlack * (q.cwiseAbs().maxCoeff() + width * (1 + std::max({in.bin_dims[0], in.bin_dims[1], in.bin_dims[2]})));
+  auto gap = [&](int a, std::int32_t b) {
+    const double lo = b * width - q[a], hi = q[a] - (b + 1) * width;
+    return std::max({b > 0 ? lo : 0.0, b + 1 < in.bin_dims[static_cast<std::size_t>(a)] ? hi : 0.0, 0.0});
+  };
+  // Whether a bin (or row of bins) whose squared gaps along the other axes sum to g2 may hold
+  // a point within cutoff() of q.
+  auto in_reach = [&](double g2) {
+    const double reach = cutoff() + bound_slack;
+    return g2 <= reach * reach;
+  };
+  // g2: the squared gaps along y and z of the bin's row.
+  auto visit_bin = [&](std::int32_t bx, std::int32_t by, std::int32_t bz, double g2) {
+    const double gx = gap(0, bx);
+    if (!in_reach(g2 + gx * gx)) return;
     const auto b = static_cast<std::size_t>(bin_id(in, bx, by, bz));
     const std::int32_t* first = in.bin_tris.data() + in.bin_offsets[b];
     const std::int32_t* last = in.bin_tris.data() + in.bin_offsets[b + 1];
@@ -158,16 +179,21 @@ void for_each_nearest_first(const DvdInput& in, const Vec3& q,
     const std::int32_t z0 = std::max(range.lo[2], c[2] - r), z1 = std::min(range.hi[2], c[2] + r);
     const std::int32_t y0 = std::max(range.lo[1], c[1] - r), y1 = std::min(range.hi[1], c[1] + r);
     const std::int32_t x0 = std::max(range.lo[0], c[0] - r), x1 = std::min(range.hi[0], c[0] + r);
-    for (std::int32_t bz = z0; bz <= z1; ++bz)
+    for (std::int32_t bz = z0; bz <= z1; ++bz) {
+      const double gz = gap(2, bz);
+      if (!in_reach(gz * gz)) continue;
       for (std::int32_t by = y0; by <= y1; ++by) {
+        const double gy = gap(1, by), g2 = gy * gy + gz * gz;
+        if (!in_reach(g2)) continue;
         const bool shell = std::abs(bz - c[2]) == r || std::abs(by - c[1]) == r;
         if (shell) {
-          for (std::int32_t bx = x0; bx <= x1; ++bx) visit_bin(bx, by, bz);
+          for (std::int32_t bx = x0; bx <= x1; ++bx) visit_bin(bx, by, bz, g2);
         } else {
-          if (c[0] - r >= range.lo[0]) visit_bin(c[0] - r, by, bz);
-          if (r > 0 && c[0] + r <= range.hi[0]) visit_bin(c[0] + r, by, bz);
+          if (c[0] - r >= range.lo[0]) visit_bin(c[0] - r, by, bz, g2);
+          if (r > 0 && c[0] + r <= range.hi[0]) visit_bin(c[0] + r, by, bz, g2);
         }
       }
+    }
   }
 }
 
