@@ -320,9 +320,9 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   // 2 band_cap it spans 2 or 3 bins per axis on every grid. Bins of kBinSize voxels of a grid
   // finer than the default one made the walk cross more bins the finer the grid (skirt at
   // --grid 512: 11 voxels of band, up to 7 bins per axis), each triangle listed in more of
-  // them: there the CPU walk took 706 ms per frame instead of 131 (frames 10-12). On the default grid and
-  // coarser ones, 2 band_cap is kBinSize cells (band_cap / cell is exactly 2: in.grid.cell is
-  // sg.grid.cell times a power of two).
+  // them: there the CPU walk took 706 ms per frame instead of 131 (frames 10-12). On the
+  // default grid and coarser ones, 2 band_cap is kBinSize cells (band_cap / cell is exactly 2:
+  // in.grid.cell is sg.grid.cell divided by a power of two).
   const double cap_cells = out.band_cap / (sg.unit * in.grid.cell);
   const auto bin_side = std::max(kBinSize, static_cast<std::int32_t>(std::lround(2 * cap_cells)));
   set_bin_layout(in, bin_size_for(in.grid, bin_side));
