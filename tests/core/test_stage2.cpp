@@ -178,8 +178,9 @@ TEST(Stage2, OnlyTrianglesNearAnotherObjectAreSampled) {
       for (const AABB& bt : boxes.triangles[i]) within_u += box_distance_squared(bt, boxes.objects[1 - i]) <= r * r;
     }
     EXPECT_LE(vb.sampled_triangles, within_u);
-    // The backend gets the blob and the sheet's triangles near it only (in bins of 4 cells
-    // around the samples: at grid 16 a quarter of the sheet's bins).
+    // The backend gets the blob and the sheet's triangles near it only (in bins of 4 cells, 4
+    // of the default grid on finer grids, around the samples: at grid 16 a quarter of the
+    // sheet's bins).
     const auto blob = static_cast<std::uint64_t>(frame.objects[1].num_triangles());
     ASSERT_GE(vb.backend_triangles, blob);
     EXPECT_LT(vb.backend_triangles - blob, static_cast<std::uint64_t>(frame.objects[0].num_triangles() / 2));
