@@ -49,7 +49,8 @@ std::vector<std::pair<std::size_t, std::size_t>> plan_batches(const Context& con
 
 DvdSharedBuffers DvdSharedBuffers::upload(const Context& context, const DvdInput& in) {
   const std::size_t tri_count = in.tri_site.size();
-  std::vector<std::int32_t> tri_info(4 * tri_count);
+  // Per triangle (dvd2_gather.comp): site and first bin, then 0 and last bin.
+  std::vector<std::int32_t> tri_info(8 * tri_count);
   for (std::size_t t = 0; t < tri_count; ++t) {
     const double* c = &in.tri_xyz_d[9 * t];
     const Vec3 lo(std::min({c[0], c[3], c[6]}), std::min({c[1], c[4], c[7]}),
@@ -57,8 +58,11 @@ DvdSharedBuffers DvdSharedBuffers::upload(const Context& context, const DvdInput
     const Vec3 hi(std::max({c[0], c[3], c[6]}), std::max({c[1], c[4], c[7]}),
                   std::max({c[2], c[5], c[8]}));
     const BinRange range = bins_overlapping(in, lo, hi);
-    tri_info[4 * t] = in.tri_site[t];
-    for (std::size_t a = 0; a < 3; ++a) tri_info[4 * t + 1 + a] = range.lo[a];
+    tri_info[8 * t] = in.tri_site[t];
+    for (std::size_t a = 0; a < 3; ++a) {
+      tri_info[8 * t + 1 + a] = range.lo[a];
+      tri_info[8 * t + 5 + a] = range.hi[a];
+    }
   }
   return {StorageBuffer::from_vector(context, in.tri_xyz),
           StorageBuffer::from_vector(context, tri_info),

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/voronoi/bins.hpp"
+#include "core/voronoi/cpu_gather.hpp"
 #include "core/parallel.hpp"
 #include "gl/dvd_gather_common.hpp"
 #include "gl/shader_source.hpp"
@@ -67,10 +68,22 @@ SelfDvdOutput GlSelfVoronoiBackend::compute(const SelfDvdInput& self) {
     for (std::size_t t = 0; t < tri_count; ++t)
       for (std::size_t a = 0; a < 3; ++a) tri_vertices[4 * t + a] = self.tri_vertices[3 * t + a];
     vertices.emplace(StorageBuffer::from_vector(context_, tri_vertices));
+    // Per sample (binding 6): its triangle, and the ids of its object's triangles, which the
+    // shader visits in one run per bin: consecutive when triangles are listed in object order,
+    // else all triangles.
+    const bool sorted = std::is_sorted(in.tri_site.begin(), in.tri_site.end());
+    std::vector<std::int32_t> sample_tris;
     for (const auto& [first, count] : plan_batches(context_, program_, sample_count, options_.max_groups_per_dispatch)) {
-      const auto begin = self.sample_triangle.begin() + static_cast<std::ptrdiff_t>(first);
+      sample_tris.assign(4 * count, 0);
+      for (std::size_t k = 0; k < count; ++k) {
+        const std::int32_t f = self.sample_triangle[first + k];
+        const SkippedTriangles run = site_triangles(in, sorted, in.tri_site[static_cast<std::size_t>(f)]);
+        sample_tris[4 * k] = f;
+        sample_tris[4 * k + 1] = sorted ? run.lo : 0;
+        sample_tris[4 * k + 2] = sorted ? run.hi : static_cast<std::int32_t>(tri_count);
+      }
       batches.push_back({first, count, StorageBuffer::from_vector(context_, pack_samples(in, first, count)),
-                         StorageBuffer::from_vector(context_, std::vector<std::int32_t>(begin, begin + static_cast<std::ptrdiff_t>(count))),
+                         StorageBuffer::from_vector(context_, sample_tris),
                          StorageBuffer(context_, 16 * count, GL_STREAM_READ)});
     }
   });

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/timer.hpp"
+#include "core/voronoi/cpu_gather.hpp"
 #include "core/voronoi/bins.hpp"
 
 namespace vproxq::gl {
@@ -159,11 +160,19 @@ DvdOutput GlVoronoiBackend::compute(const DvdInput& in) {
   std::optional<DvdSharedBuffers> shared;
   out.upload_ms = finish_timed_ms(context_, [&] {
     shared.emplace(DvdSharedBuffers::upload(context_, in));
+    // Per sample (binding 8): the excluded site, and the ids of its triangles when they are
+    // consecutive, which the shader passes over in one step per bin.
+    const bool sorted = std::is_sorted(in.tri_site.begin(), in.tri_site.end());
     std::vector<std::int32_t> exclude;
     for (const auto& [first, count] : plan_batches(context_, program_, voxel_count, options_.max_groups_per_dispatch)) {
-      exclude.assign(count, kNoIndex);
-      if (!in.exclude_site.empty())
-        std::copy_n(in.exclude_site.begin() + static_cast<std::ptrdiff_t>(first), count, exclude.begin());
+      exclude.assign(4 * count, 0);
+      for (std::size_t k = 0; k < count; ++k) {
+        const std::int32_t site = in.exclude_site.empty() ? kNoIndex : in.exclude_site[first + k];
+        const SkippedTriangles run = site_triangles(in, sorted, site);
+        exclude[4 * k] = site;
+        exclude[4 * k + 1] = run.lo;
+        exclude[4 * k + 2] = run.hi;
+      }
       batches.push_back({first, count, StorageBuffer::from_vector(context_, pack_samples(in, first, count)),
                          StorageBuffer::from_vector(context_, exclude),
                          StorageBuffer(context_, 16 * count, GL_STREAM_READ)});
@@ -171,6 +180,7 @@ DvdOutput GlVoronoiBackend::compute(const DvdInput& in) {
   });
 
   set_dvd_uniforms(program_, in, float32_error_bound(dvd_input_extent(in)));
+  program_.set_int("bin_dims_z", in.bin_dims[2]);  // for the walk's bin gaps
   shared->bind();
   out.compute_ms = dispatch_batches(context_, program_, batches, [](const Batch& batch) {
     batch.samples.bind(4);

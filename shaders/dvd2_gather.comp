@@ -5,8 +5,9 @@
 //
 // Storage buffers (std430; coordinates relative to the grid origin):
 //   binding 0  triangles      9 floats per triangle: x0 y0 z0 x1 y1 z1 x2 y2 z2
-//   binding 1  triangle_info  ivec4 per triangle: site, and the bin coordinates (x, y, z) of the
-//                             first bin its bounding box overlaps (to visit it only once)
+//   binding 1  triangle_info  2 ivec4 per triangle: [2t] site and the bin coordinates (x, y, z)
+//                             of the first bin its bounding box overlaps, [2t + 1] 0 and those
+//                             of the last (to visit it only once: visit_here())
 //   binding 2  bin_offsets    CSR offsets, bin count + 1 ints
 //   binding 3  bin_triangles  triangle ids, bin after bin
 //   binding 4  samples        uvec4 per sample voxel of this batch: its voxel coordinates
@@ -17,9 +18,11 @@
 //                             some drivers cap an invocation's loop iterations (Mesa's llvmpipe
 //                             stops every loop after 65535 in all, silently), and the host then
 //                             computes that sample another way
-//   binding 8  exclude_sites  int per sample voxel of this batch: a site whose triangles are
-//                             ignored there (DvdInput::exclude_site), or -1
-// Uniforms: sample_count (this batch), cell, dims_x/y/z (grid), bin_size, bin_dims_x/y,
+//   binding 8  exclude_sites  ivec4 per sample voxel of this batch: a site whose triangles are
+//                             ignored there (DvdInput::exclude_site), or -1; the ids [y, z) of
+//                             its triangles when they are consecutive (triangles listed in
+//                             site order), else y = z (bin_run()); and 0
+// Uniforms: sample_count (this batch), cell, dims_x/y/z (grid), bin_size, bin_dims_x/y/z,
 // prefilter_margin (see below).
 // Defines: LOCAL_SIZE, the work group size (default 64).
 #ifndef LOCAL_SIZE
@@ -34,7 +37,7 @@ layout(std430, binding = 2) readonly buffer BinOffsets { int bin_offsets[]; };
 layout(std430, binding = 3) readonly buffer BinTriangles { int bin_triangles[]; };
 layout(std430, binding = 4) readonly buffer Samples { uvec4 samples[]; };
 layout(std430, binding = 5) writeonly buffer Results { ivec4 results[]; };
-layout(std430, binding = 8) readonly buffer ExcludeSites { int exclude_sites[]; };
+layout(std430, binding = 8) readonly buffer ExcludeSites { ivec4 exclude_sites[]; };
 
 uniform uint sample_count;
 uniform float cell;
@@ -44,6 +47,7 @@ uniform int dims_z;
 uniform int bin_size;
 uniform int bin_dims_x;
 uniform int bin_dims_y;
+uniform int bin_dims_z;
 // A triangle is skipped when the distance to its bounding box exceeds the current cut-off
 // (band, or the 2nd site's distance so far) by more than this: twice the error bound, which
 // covers the error of the box distance and of the triangle distance, so a skipped triangle's
@@ -61,6 +65,57 @@ const float kMinSquared = 7.8886090522101181e-31;  // 2^-100
 // box bounds (a few 2^-23) with a wide margin, so every bin holding a triangle within the band
 // (as binned on the host, in double) is visited.
 const float kBinSearchSlack = 3.814697265625e-06;  // 2^-18
+
+// Distance along one axis from coordinate x to bin b of n (bins `width` wide; the first and the
+// last bin reach to -infinity and +infinity: bin coordinates are clamped to the grid).
+float bin_axis_gap(float x, int b, int n, float width) {
+  float below = b > 0 ? float(b) * width - x : 0.0;
+  float above = b + 1 < n ? x - float(b + 1) * width : 0.0;
+  return max(max(below, above), 0.0);
+}
+
+// The entries of a bin's list [from, to) (ascending triangle ids) holding the ids [lo, hi), as
+// [run.x, run.y): a binary search instead of stepping over the entries one by one (a site's
+// triangles are consecutive ids: they are one run per bin). run.z is 1 when the positions are
+// not what they should be (a search the driver's loop cap cut short: dvd2_gather's kIncomplete).
+int first_not_below(int from, int to, int t) {
+  int lo = from;
+  int hi = to;
+  while (lo < hi) {
+    int mid = (lo + hi) / 2;
+    if (bin_triangles[mid] < t) {
+      lo = mid + 1;
+    } else {
+      hi = mid;
+    }
+  }
+  return lo;
+}
+
+bool is_first_not_below(int from, int to, int t, int p) {
+  return from <= p && p <= to && (p == from || bin_triangles[p - 1] < t) && (p == to || bin_triangles[p] >= t);
+}
+
+ivec3 bin_run(int from, int to, int lo, int hi) {
+  // No search where the bin holds none of the ids, or only them (the common cases).
+  if (from == to || bin_triangles[from] >= hi || bin_triangles[to - 1] < lo) {
+    return ivec3(from, from, 0);
+  }
+  if (bin_triangles[from] >= lo && bin_triangles[to - 1] < hi) {
+    return ivec3(from, to, 0);
+  }
+  int p0 = first_not_below(from, to, lo);
+  int p1 = first_not_below(p0, to, hi);
+  bool ok = is_first_not_below(from, to, lo, p0) && is_first_not_below(p0, to, hi, p1);
+  return ivec3(p0, p1, ok ? 0 : 1);
+}
+
+// Whether triangle t, listed in bin `here`, whose range of bins starts at `first`, is visited
+// there: `here` is the bin of its range nearest to `home` (per axis, home's coordinate clamped
+// to the range).
+bool visit_here(int t, ivec3 first, ivec3 here, ivec3 home) {
+  return clamp(home, first, triangle_info[2 * t + 1].yzw) == here;
+}
 
 // Squared distance from p to the segment [a, a + e], from w = p - a, e and ee = dot(e, e).
 // A segment with ee <= kMinSquared is its point a.
@@ -142,13 +197,79 @@ vec3 corner(int t, int k) {
   return vec3(triangles[i], triangles[i + 1], triangles[i + 2]);
 }
 
+// Takes triangle t of site s into the two nearest distinct sites (d1, s1), (d2, s2) of q
+// (squared distances), unless its bounding box lies beyond the cut-off; shrinks the cut-off
+// when the distance it depends on (d1 with nearest_only, else d2) shrinks.
+void consider(int t, int s, vec3 q, float band, bool nearest_only, inout float d1, inout float d2,
+              inout int s1, inout int s2, inout float cutoff, inout float cutoff_squared) {
+  vec3 a = corner(t, 0);
+  vec3 b = corner(t, 1);
+  vec3 c = corner(t, 2);
+  vec3 gap = max(max(min(min(a, b), c) - q, q - max(max(a, b), c)), vec3(0.0));
+  if (dot(gap, gap) > cutoff_squared) {
+    return;
+  }
+  float d = point_triangle_distance_squared(q, a, b, c);
+  float previous_limit = nearest_only ? d1 : d2;
+  if (s == s1) {
+    d1 = min(d1, d);
+  } else if (before(d, s, d1, s1)) {
+    d2 = d1;  // also right when s == s2: its old, larger value is dropped
+    s2 = s1;
+    d1 = d;
+    s1 = s;
+  } else if (s == s2) {
+    d2 = min(d2, d);
+  } else if (before(d, s, d2, s2)) {
+    d2 = d;
+    s2 = s;
+  }
+  float limit = nearest_only ? d1 : d2;
+  if (limit != previous_limit) {
+    cutoff = min(band, sqrt(limit)) + prefilter_margin;
+    cutoff_squared = cutoff * cutoff;
+  }
+}
+
+// Visits the entries of bin `here` for the sample at q: the excluded site's run
+// of entries is passed over (bin_run()), and each other triangle is taken in (consider()) when
+// this is the bin visit_here() picks for it. Counts what it plans and visits (kIncomplete).
+void scan_bin(ivec3 here, ivec3 home, vec3 q, float band, ivec4 exclude, bool nearest_only,
+              inout float d1, inout float d2, inout int s1, inout int s2, inout float cutoff,
+              inout float cutoff_squared, inout int entries_planned, inout int entries_visited,
+              inout bool searches_ok) {
+  int b = here.x + bin_dims_x * (here.y + bin_dims_y * here.z);
+  int begin = bin_offsets[b];
+  int end = bin_offsets[b + 1];
+  // Entries [begin, run.x) and [run.y, end) are visited.
+  ivec3 run = ivec3(end, end, 0);
+  if (exclude.y < exclude.z) {
+    run = bin_run(begin, end, exclude.y, exclude.z);
+    searches_ok = searches_ok && run.z == 0;
+  }
+  entries_planned += (run.x - begin) + (end - run.y);
+  for (int j = begin; j < end; ++j) {
+    if (j == run.x && run.x < run.y) {
+      j = run.y - 1;
+      continue;
+    }
+    ++entries_visited;
+    int t = bin_triangles[j];
+    ivec4 info = triangle_info[2 * t];
+    if (info.x != exclude.x && visit_here(t, info.yzw, here, home)) {
+      consider(t, info.x, q, band, nearest_only, d1, d2, s1, s2, cutoff, cutoff_squared);
+    }
+  }
+}
+
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= sample_count) {
     return;
   }
   float band = uintBitsToFloat(samples[i].w);
-  int skip = exclude_sites[i];
+  ivec4 exclude = exclude_sites[i];
+  int skip = exclude.x;
   // With an excluded site only the nearest other site is asked for (DvdOutput).
   bool nearest_only = skip != kNoIndex;
   ivec3 voxel = ivec3(samples[i].xyz);
@@ -169,55 +290,42 @@ void main() {
   int s2 = kNoSite;
   float cutoff = band + prefilter_margin;
   float cutoff_squared = cutoff * cutoff;
+
+  // The walk: first the sample's own bin `home` (what it finds shortens the cut-off for the
+  // others), then the bins of [bin_lo, bin_hi] in (z, y, x) order but home. A bin farther from
+  // q than the cut-off is passed over, and a triangle listed in several bins is visited in one
+  // only, the bin of its range nearest to home (visit_here()), which is also the bin of its
+  // range nearest to q. So every triangle having a point within the cut-off of q is visited,
+  // once: that point lies in a bin of its range, no nearer to q than the one visit_here()
+  // picks, which is therefore not passed over. The bins' bounds float(b) * width and q are off
+  // by a few float ulps (2^-23) of the coordinates' magnitude, at most about dims + 2 bin_size
+  // cells; bin_slack (kBinSearchSlack, 2^-18 of that) covers it, as it covers the host's
+  // binning in double.
+  ivec3 home = voxel / bin_size;
+  float width = cell * float(bin_size);
+  float bin_slack = kBinSearchSlack * cell * float(max(dims_x, max(dims_y, dims_z)) + 2 * bin_size);
   // What the loops must visit, and what they did (see kIncomplete).
-  uint bins_planned = uint(bin_hi.x - bin_lo.x + 1) * uint(bin_hi.y - bin_lo.y + 1) * uint(bin_hi.z - bin_lo.z + 1);
-  uint bins_visited = 0u;
+  ivec3 span = bin_hi - bin_lo + 1;
+  int bins_planned = span.x * span.y * span.z + 1;
+  int bins_visited = 0;
   int entries_planned = 0;
   int entries_visited = 0;
+  bool searches_ok = true;
+  scan_bin(home, home, q, band, exclude, nearest_only, d1, d2, s1, s2, cutoff, cutoff_squared,
+           entries_planned, entries_visited, searches_ok);
+  ++bins_visited;
   for (int bz = bin_lo.z; bz <= bin_hi.z; ++bz) {
+    float gz = bin_axis_gap(q.z, bz, bin_dims_z, width);
     for (int by = bin_lo.y; by <= bin_hi.y; ++by) {
+      float gy = bin_axis_gap(q.y, by, bin_dims_y, width);
       for (int bx = bin_lo.x; bx <= bin_hi.x; ++bx) {
         ivec3 here = ivec3(bx, by, bz);
-        int b = bx + bin_dims_x * (by + bin_dims_y * bz);
-        int end = bin_offsets[b + 1];
         ++bins_visited;
-        entries_planned += end - bin_offsets[b];
-        for (int j = bin_offsets[b]; j < end; ++j) {
-          ++entries_visited;
-          int t = bin_triangles[j];
-          ivec4 info = triangle_info[t];
-          // Visit a triangle once: in the first visited bin of its own range.
-          if (max(info.yzw, bin_lo) != here || info.x == skip) {
-            continue;
-          }
-          vec3 a = corner(t, 0);
-          vec3 b3 = corner(t, 1);
-          vec3 c = corner(t, 2);
-          vec3 gap = max(max(min(min(a, b3), c) - q, q - max(max(a, b3), c)), vec3(0.0));
-          if (dot(gap, gap) > cutoff_squared) {
-            continue;
-          }
-          float d = point_triangle_distance_squared(q, a, b3, c);
-          int s = info.x;
-          float previous_limit = nearest_only ? d1 : d2;
-          if (s == s1) {
-            d1 = min(d1, d);
-          } else if (before(d, s, d1, s1)) {
-            d2 = d1;  // also right when s == s2: its old, larger value is dropped
-            s2 = s1;
-            d1 = d;
-            s1 = s;
-          } else if (s == s2) {
-            d2 = min(d2, d);
-          } else if (before(d, s, d2, s2)) {
-            d2 = d;
-            s2 = s;
-          }
-          float limit = nearest_only ? d1 : d2;
-          if (limit != previous_limit) {
-            cutoff = min(band, sqrt(limit)) + prefilter_margin;
-            cutoff_squared = cutoff * cutoff;
-          }
+        float gx = bin_axis_gap(q.x, bx, bin_dims_x, width);
+        float in_reach = cutoff + bin_slack;
+        if (here != home && gx * gx + gy * gy + gz * gz <= in_reach * in_reach) {
+          scan_bin(here, home, q, band, exclude, nearest_only, d1, d2, s1, s2, cutoff, cutoff_squared,
+                   entries_planned, entries_visited, searches_ok);
         }
       }
     }
@@ -226,7 +334,7 @@ void main() {
   float dist2 = sqrt(d2);
   bool has1 = s1 != kNoSite && dist1 < band;
   bool has2 = !nearest_only && s2 != kNoSite && dist2 < band;
-  bool complete = bins_visited == bins_planned && entries_visited == entries_planned;
+  bool complete = bins_visited == bins_planned && entries_visited == entries_planned && searches_ok;
   results[i] = ivec4(complete ? (has1 ? s1 : kNoIndex) : kIncomplete, has2 ? s2 : kNoIndex,
                      floatBitsToInt(has1 ? dist1 : band), floatBitsToInt(has2 ? dist2 : band));
 }

@@ -255,6 +255,61 @@ TEST(GlVoronoi, MatchesDoubleReferenceOnRandomScenes) {
   RecordProperty("max_error_over_bound", std::to_string(stats.max_ratio));
 }
 
+/// `in` with its triangles listed in site order (stable) and binned again: as Stage II lists
+/// them (object order), so that each excluded site's triangles are one run per bin, which the
+/// shader passes over by binary search instead of entry by entry.
+DvdInput in_site_order(const DvdInput& in) {
+  std::vector<std::size_t> order(in.tri_site.size());
+  for (std::size_t t = 0; t < order.size(); ++t) order[t] = t;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return in.tri_site[a] < in.tri_site[b]; });
+  DvdInput sorted = in;
+  sorted.tri_xyz.clear();
+  sorted.tri_xyz_d.clear();
+  sorted.tri_site.clear();
+  for (const std::size_t t : order) {
+    sorted.tri_xyz.insert(sorted.tri_xyz.end(), in.tri_xyz.begin() + 9 * static_cast<std::ptrdiff_t>(t),
+                          in.tri_xyz.begin() + 9 * static_cast<std::ptrdiff_t>(t + 1));
+    sorted.tri_xyz_d.insert(sorted.tri_xyz_d.end(), in.tri_xyz_d.begin() + 9 * static_cast<std::ptrdiff_t>(t),
+                            in.tri_xyz_d.begin() + 9 * static_cast<std::ptrdiff_t>(t + 1));
+    sorted.tri_site.push_back(in.tri_site[t]);
+  }
+  bin_triangles(sorted, in.bin_size);
+  return sorted;
+}
+
+// With triangles in site order the shader passes over the excluded site's run of entries in
+// each bin (a binary search, checked). Sites here are slabs along x, 1.5 cells thick, and each
+// sample excludes its own slab, so the nearest other site is often the slab beside it, whose
+// triangles' ids border the run: a run one entry too long at either end would drop one of
+// them. The answers must match the reference, computed on the GPU: a search that went wrong
+// would be redone on the CPU (last_redone()).
+TEST(GlVoronoi, TrianglesInSiteOrderMatchTheReference) {
+  VPROXQ_GL_CONTEXT_OR_FAIL(context);
+  GlVoronoiBackend backend(context);
+  CheckStats stats;
+  for (unsigned seed : {5u, 6u, 7u}) {
+    SCOPED_TRACE(::testing::Message() << "seed " << seed);
+    SceneOptions options;
+    options.triangles = 2000;
+    DvdInput in = random_scene(seed, options);
+    const double slab = 1.5 * in.grid.cell;
+    for (std::size_t t = 0; t < in.tri_site.size(); ++t) {
+      const Triangle tri = triangle_of(in, t);
+      const double x = (tri[0][0] + tri[1][0] + tri[2][0]) / 3;  // relative to the origin
+      in.tri_site[t] = static_cast<std::int32_t>(std::clamp(std::floor(x / slab), 0.0, 1000.0));
+    }
+    for (std::size_t k = 0; k < in.voxels.size(); ++k) {
+      const double x = sample_point(in.grid, in.voxels[k])[0];
+      in.exclude_site[k] = k % 3 == 2 ? kNoIndex : static_cast<std::int32_t>(std::floor(x / slab));
+    }
+    in = in_site_order(in);
+    const double bound = backend.distance_error_bound(extent_of(in));
+    check_against_reference(in, reference(in), backend.compute(in), bound, stats);
+    EXPECT_EQ(backend.last_redone(), 0u);
+  }
+  std::cout << stats.values << " distances: max |GPU - exact| / bound = " << stats.max_ratio << "\n";
+}
+
 TEST(GlVoronoi, AgreesWithCpuBackend) {
   VPROXQ_GL_CONTEXT_OR_FAIL(context);
   GlVoronoiBackend gpu(context);
