@@ -18,10 +18,10 @@ namespace vproxq {
 namespace {
 
 // Voxelization and its slack: StageGrid (grid_setup.hpp), shared with the self Stage II.
-// Bins of this many voxels per side for the backends' triangle lookup, at least: on grids
-// finer than the default one, bins of twice the band's cap (kBinSize cells of the default
-// grid), and more on very fine grids (bin_size_for()).
-constexpr std::int32_t kBinSize = 4;
+// The backends' triangle bins are twice the band's cap wide (4 voxels on the default grid),
+// or as wide as the cap where the frame's median triangle box (longest side) is at most this
+// many caps: see the bins' comment in compute_voronoi_bounds().
+constexpr double kSmallTriangleCaps = 0.625;
 // Stage II's sampling filter asks each nearby object's triangle hierarchy while an object has
 // at most this many nearby objects, else the owner grid.
 constexpr std::size_t kFewNearObjects = 8;
@@ -317,14 +317,30 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   // sample's walk can reach (reachable_triangles()). Most triangles of a frame are far from
   // every sample, and preparing them cost more than the samples did.
   // A sample's walk reaches its band (at most band_cap) around its voxel, so with bins of
-  // 2 band_cap it spans 2 or 3 bins per axis on every grid. Bins of kBinSize voxels of a grid
-  // finer than the default one made the walk cross more bins the finer the grid (skirt at
+  // 2 band_cap it spans 2 or 3 bins per axis on every grid. Bins of 4 voxels on a grid finer
+  // than the default one made the walk cross more bins the finer the grid (skirt at
   // --grid 512: 11 voxels of band, up to 7 bins per axis), each triangle listed in more of
   // them: there the CPU walk took 706 ms per frame instead of 131 (frames 10-12). On the
-  // default grid and coarser ones, 2 band_cap is kBinSize cells (band_cap / cell is exactly 2:
+  // default grid and coarser ones, band_cap is 2 cells (band_cap / cell is exactly 2:
   // in.grid.cell is sg.grid.cell divided by a power of two).
+  // Where the triangles are small next to the band (median box side at most
+  // kSmallTriangleCaps caps: 1.25 voxels on the default grid), bins as wide as the cap hold
+  // fewer triangles each, and few triangles are listed in several: inter-object backend ms per
+  // frame with bins of 2 / 4 voxels (default grid; cpu, gpu on llvmpipe): funnel (median
+  // 0.83 voxels) 23.2 / 27.3 and 88.8 / 159.6, cloth-ball (0.93) 3.0 / 4.0 and 10.9 / 13.9,
+  // breaking (1.04) 1.5 / 1.9 and 5.5 / 7.1, bowl (1.10) 2.5 / 2.7 and 10.5 / 12.0; but
+  // skirt (1.51) 8.6 / 5.0 and 34.8 / 19.0, blobs-200 (2.79) 4.4 / 4.5 and 20.0 / 12.6.
   const double cap_cells = out.band_cap / (sg.unit * in.grid.cell);
-  const auto bin_side = std::max(kBinSize, static_cast<std::int32_t>(std::lround(2 * cap_cells)));
+  std::vector<double> sides;
+  for (size_t i = 0; i < n; ++i)
+    for (const AABB& b : boxes.triangles[i]) sides.push_back((b.hi - b.lo).maxCoeff());
+  bool small_triangles = false;
+  if (!sides.empty()) {
+    const auto mid = sides.begin() + static_cast<std::ptrdiff_t>(sides.size() / 2);
+    std::nth_element(sides.begin(), mid, sides.end());
+    small_triangles = *mid <= kSmallTriangleCaps * out.band_cap;
+  }
+  const auto bin_side = std::max<std::int32_t>(1, static_cast<std::int32_t>(std::lround((small_triangles ? 1 : 2) * cap_cells)));
   set_bin_layout(in, bin_size_for(in.grid, bin_side));
   const std::vector<std::vector<Index>> kept = reachable_triangles(
       in, sg, boxes, threads, [](size_t) { return true; }, [](size_t, Index) { return false; });
