@@ -79,7 +79,7 @@ SelfDvdOutput GlSelfVoronoiBackend::compute(const SelfDvdInput& self) {
         const std::int32_t f = self.sample_triangle[first + k];
         const SkippedTriangles run = site_triangles(in, sorted, in.tri_site[static_cast<std::size_t>(f)]);
         sample_tris[4 * k] = f;
-        sample_tris[4 * k + 1] = sorted ? run.lo : 0;
+        sample_tris[4 * k + 1] = run.lo;  // 0 when not sorted (site_triangles())
         sample_tris[4 * k + 2] = sorted ? run.hi : static_cast<std::int32_t>(tri_count);
       }
       batches.push_back({first, count, StorageBuffer::from_vector(context_, pack_samples(in, first, count)),

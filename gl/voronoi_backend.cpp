@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "core/timer.hpp"
-#include "core/voronoi/cpu_gather.hpp"
 #include "core/voronoi/bins.hpp"
+#include "core/voronoi/cpu_gather.hpp"
 
 namespace vproxq::gl {
 

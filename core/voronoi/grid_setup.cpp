@@ -3,6 +3,8 @@
 #include "core/parallel.hpp"
 #include "core/voronoi/bins.hpp"
 
+#include <algorithm>
+
 namespace vproxq {
 
 namespace {
@@ -20,6 +22,18 @@ void put_triangle(DvdInput& in, const Frame& frame, const StageGrid& sg, size_t 
 }
 
 }  // namespace
+
+double median_triangle_side(const FrameBoxes& boxes, const std::function<bool(size_t)>& include) {
+  std::vector<double> sides;
+  for (size_t i = 0; i < boxes.triangles.size(); ++i) {
+    if (!include(i)) continue;
+    for (const AABB& b : boxes.triangles[i]) sides.push_back((b.hi - b.lo).maxCoeff());
+  }
+  if (sides.empty()) return 0;
+  const auto mid = sides.begin() + static_cast<std::ptrdiff_t>(sides.size() / 2);
+  std::nth_element(sides.begin(), mid, sides.end());
+  return *mid;
+}
 
 void fill_dvd_triangles(DvdInput& in, const Frame& frame, const StageGrid& sg,
                         const std::vector<std::vector<Index>>& kept) {

@@ -158,6 +158,10 @@ struct StageGrid {
   }
 };
 
+/// The median (the upper one, for an even count) of the longest sides of the triangle boxes of
+/// the objects i with include(i); 0 when they have no triangle.
+double median_triangle_side(const FrameBoxes& boxes, const std::function<bool(size_t)>& include);
+
 /// Fills in.tri_xyz, in.tri_xyz_d (relative to sg.grid.origin, in backend units:
 /// backend_coord()) and in.tri_site (object id) with the triangles kept[i] of each object i
 /// (ascending), in object order.

@@ -119,15 +119,8 @@ SelfVoronoiBounds compute_self_voronoi_bounds(const Frame& frame, const FrameBox
 
   int res = grid_resolution;
   if (res <= 0) {
-    std::vector<double> size;
-    size.reserve(static_cast<size_t>(total_tris));
-    for (size_t i = 0; i < n; ++i) {
-      if (!gridded_object(i)) continue;
-      for (const AABB& b : boxes.triangles[i]) size.push_back((b.hi - b.lo).maxCoeff());
-    }
-    auto mid = size.begin() + static_cast<std::ptrdiff_t>(size.size() / 2);
-    std::nth_element(size.begin(), mid, size.end());
-    res = default_self_grid_resolution(total_tris, (scene.hi - scene.lo).maxCoeff(), *mid);
+    res = default_self_grid_resolution(total_tris, (scene.hi - scene.lo).maxCoeff(),
+                                       median_triangle_side(boxes, gridded_object));
   }
   const StageGrid sg = StageGrid::over(scene, res);
   out.grid = sg.grid;

@@ -331,15 +331,8 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
   // breaking (1.04) 1.5 / 1.9 and 5.5 / 7.1, bowl (1.10) 2.5 / 2.7 and 10.5 / 12.0; but
   // skirt (1.51) 8.6 / 5.0 and 34.8 / 19.0, blobs-200 (2.79) 4.4 / 4.5 and 20.0 / 12.6.
   const double cap_cells = out.band_cap / (sg.unit * in.grid.cell);
-  std::vector<double> sides;
-  for (size_t i = 0; i < n; ++i)
-    for (const AABB& b : boxes.triangles[i]) sides.push_back((b.hi - b.lo).maxCoeff());
-  bool small_triangles = false;
-  if (!sides.empty()) {
-    const auto mid = sides.begin() + static_cast<std::ptrdiff_t>(sides.size() / 2);
-    std::nth_element(sides.begin(), mid, sides.end());
-    small_triangles = *mid <= kSmallTriangleCaps * out.band_cap;
-  }
+  const bool small_triangles =
+      median_triangle_side(boxes, [](size_t) { return true; }) <= kSmallTriangleCaps * out.band_cap;
   const auto bin_side = std::max<std::int32_t>(1, static_cast<std::int32_t>(std::lround((small_triangles ? 1 : 2) * cap_cells)));
   set_bin_layout(in, bin_size_for(in.grid, bin_side));
   const std::vector<std::vector<Index>> kept = reachable_triangles(
