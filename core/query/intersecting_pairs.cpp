@@ -58,8 +58,12 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
     add_chunks(from, into);
     needs_bvh[static_cast<size_t>(into)] = 1;
   }
+  const auto intra_known = [&](size_t i) {
+    return opts.intra_known != nullptr && i < opts.intra_known->size() && (*opts.intra_known)[i] != 0;
+  };
   if (opts.intra) {
     for (size_t i = 0; i < n; ++i) {
+      if (intra_known(i)) continue;
       add_chunks(static_cast<Index>(i), static_cast<Index>(i));
       needs_bvh[i] = 1;
     }
@@ -70,7 +74,7 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
   std::vector<std::vector<std::array<Index, 3>>> common(n);
   if (opts.intra)
     parallel_for(n, threads, [&](size_t i) {
-      if (frame.objects[i].num_triangles() > 0)
+      if (frame.objects[i].num_triangles() > 0 && !intra_known(i))
         common[i] = boxes.bvh(i).node_common_vertices(frame.objects[i].topology->faces);
     });
 
@@ -132,6 +136,9 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
     out.pairs.insert(out.pairs.end(), found[k].begin(), found[k].end());
     out.exact_tests += tests[k];
   }
+  if (opts.intra && opts.intra_pairs != nullptr)
+    for (const IntersectingPair& p : *opts.intra_pairs)
+      if (intra_known(static_cast<size_t>(p.object_a))) out.pairs.push_back(p);
   // Items are already in canonical order except that intra items follow the inter ones.
   std::sort(out.pairs.begin(), out.pairs.end());
   out.ms = sw.elapsed_ms();

@@ -19,11 +19,18 @@ struct IntersectingPairsOptions {
   /// intra-object search does not use them (D_l is a distance to other objects).
   const VoronoiBounds* voronoi = nullptr;
   bool intra = true;  ///< also list pairs within one object
+  /// With `intra`: pairs within objects that the caller already has, from the intra-object
+  /// distance (IntraDistanceOutput::intersecting, sorted), and per object 1 where they are
+  /// all of that object's pairs (IntraDistanceOutput::intersecting_known): those objects are
+  /// not searched again, and their pairs join the output as given. Null: search every object.
+  const std::vector<IntersectingPair>* intra_pairs = nullptr;
+  const std::vector<std::uint8_t>* intra_known = nullptr;
 };
 
 struct IntersectingPairsOutput {
   std::vector<IntersectingPair> pairs;  ///< sorted (IntersectingPair::operator<), no duplicates
-  std::uint64_t exact_tests = 0;        ///< exact triangle–triangle intersection tests run
+  std::uint64_t exact_tests = 0;        ///< exact triangle–triangle intersection tests run (not
+                                        ///< those behind `intra_pairs`)
   double ms = 0;
 };
 

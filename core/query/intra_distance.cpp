@@ -206,6 +206,7 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
   });
 
   std::vector<DistanceCounters> counters(blocks.size());
+  std::vector<std::vector<IntersectingPair>> hits(blocks.size());
   parallel_for(counters.size(), threads, [&](size_t item) {
     const auto [object, block] = blocks.locate(item);
     const size_t i = object;  // a plain variable: lambdas below capture it
@@ -261,6 +262,10 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
         }
         ++c.intra_exact_tests;
         const TriangleDistanceResult r = evaluate(o, f, g);
+        if (r.kind == TriangleDistanceCase::Intersecting) {
+          const Index io = static_cast<Index>(i);
+          hits[item].push_back({io, std::min(f, g), io, std::max(f, g)});
+        }
         pairs.offer(res.per_triangle[uf], uf, g, r);
         pairs.offer(res.per_triangle[ug], ug, f, swapped(r));
       }, adjacent_subtree);
@@ -274,6 +279,12 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     out.counters.intra_reused += c.intra_reused;
     out.counters.intra_exact_tests += c.intra_exact_tests;
   }
+  for (const auto& h : hits) out.intersecting.insert(out.intersecting.end(), h.begin(), h.end());
+  // Both sides may evaluate a pair (a side skips it only when the other's search has ended).
+  std::sort(out.intersecting.begin(), out.intersecting.end());
+  out.intersecting.erase(std::unique(out.intersecting.begin(), out.intersecting.end()), out.intersecting.end());
+  out.intersecting_known.assign(n_obj, 0);
+  for (size_t i = 0; i < n_obj; ++i) out.intersecting_known[i] = marked(opts.skip, i) ? 0 : 1;
   parallel_for(n_obj, threads, [&](size_t i) { finish_object(out.per_object[i]); });
   out.exact_ms = sw.elapsed_ms();
   return out;

@@ -2,6 +2,7 @@
 // all-non-adjacent-pairs brute force, per triangle and bitwise.
 #include "core/geometry/point_triangle.hpp"
 #include "core/mesh/adjacency.hpp"
+#include "core/query/intersecting_pairs.hpp"
 #include "core/query/intra_distance.hpp"
 #include "core/voronoi/self_stage2.hpp"
 #include "support/random_scene.hpp"
@@ -57,13 +58,37 @@ void expect_candidates_accounted(const DistanceCounters& c, const std::string& n
       << name;
 }
 
+/// The brute force's intersecting pairs within objects (exact intersection test on every pair
+/// sharing no vertex), of the objects `keep` accepts.
+template <typename Keep>
+std::vector<IntersectingPair> intra_intersecting_reference(const Frame& frame, const Keep& keep) {
+  std::vector<IntersectingPair> out;
+  for (const IntersectingPair& p : intersecting_pairs_brute_force(frame, true).pairs)
+    if (p.object_a == p.object_b && keep(static_cast<size_t>(p.object_a))) out.push_back(p);
+  return out;
+}
+std::vector<IntersectingPair> intra_intersecting_reference(const Frame& frame) {
+  return intra_intersecting_reference(frame, [](size_t) { return true; });
+}
+
+/// The search's intersecting pairs are the brute force's, and it claims every object.
+void expect_intersecting_pairs(const IntraDistanceOutput& got, const Frame& frame,
+                               const std::vector<IntersectingPair>& ref, const std::string& name) {
+  EXPECT_EQ(got.intersecting, ref) << name;
+  EXPECT_EQ(got.intersecting_known, std::vector<std::uint8_t>(frame.objects.size(), 1)) << name;
+}
+
 TEST(IntraDistance, EqualsBruteForceOnAllScenesAndThreadCounts) {
   std::uint64_t reused = 0, separated = 0;
+  size_t intersecting = 0;
   for (const auto& [name, frame] : scenes()) {
     const auto ref = intra_object_distance_brute_force(frame);
+    const auto ref_pairs = intra_intersecting_reference(frame);
+    intersecting += ref_pairs.size();
     for (int threads : {1, 3}) {
       const auto got = intra_object_distance(frame, {threads});
       expect_same_intra(got, ref, name + ", threads " + std::to_string(threads));
+      expect_intersecting_pairs(got, frame, ref_pairs, name + ", threads " + std::to_string(threads));
       EXPECT_LE(got.counters.intra_exact_tests, ref.counters.intra_exact_tests) << name;
       expect_candidates_accounted(got.counters, name);
       reused += got.counters.intra_reused;
@@ -74,6 +99,55 @@ TEST(IntraDistance, EqualsBruteForceOnAllScenesAndThreadCounts) {
   // whose boxes are within the bound but whose triangles are not are skipped untested.
   EXPECT_GT(reused, 0u);
   EXPECT_GT(separated, 0u);
+  // The soups and jittered blobs intersect themselves, or the pair lists prove little.
+  EXPECT_GT(intersecting, 100u);
+}
+
+// Large soups, searched by 3 threads in blocks of 64 triangles: a pair is then also met from
+// its higher id's side (whose block ran first) and sometimes from both sides; each intersecting
+// pair is listed once either way.
+TEST(IntraDistance, IntersectingPairsOfLargeObjectsOnManyThreadsAreListedOnce) {
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    Rng rng(seed);
+    const Frame frame = frame_of({test::make_soup(rng, Vec3::Zero(), 1.0, 0.25, 800, "soup"),
+                                  test::make_soup(rng, Vec3(0.5, 0, 0), 1.0, 0.25, 500, "soup")});
+    const auto ref = intra_intersecting_reference(frame);
+    EXPECT_GT(ref.size(), 500u);
+    for (int round = 0; round < 3; ++round)
+      expect_intersecting_pairs(intra_object_distance(frame, {3}), frame, ref, "seed " + std::to_string(seed));
+  }
+}
+
+// Objects left out (a caller's cached static objects) are not claimed: their pairs are missing
+// from the list, and the intersecting pairs search them itself. Together the lists equal the
+// brute force's, inter-object pairs included.
+TEST(IntraDistance, IntersectingPairsOfObjectsLeftOutComeFromTheirOwnSearch) {
+  size_t left_out_pairs = 0;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    Rng rng(seed);
+    Frame frame;
+    for (int i = 0; i < 4; ++i)
+      frame.objects.push_back(i % 2 == 0 ? test::make_soup(rng, Vec3(0.4 * i, 0, 0), 0.5, 0.3, 40, "soup")
+                                         : test::make_blob(rng, Vec3(0.4 * i, 0, 0), 0.6, 2, 0.5, "blob"));
+    const std::vector<std::uint8_t> skip = {0, 0, 1, 0};
+    const auto all = intersecting_pairs_brute_force(frame, true).pairs;
+    const auto kept = intra_intersecting_reference(frame, [&](size_t i) { return skip[i] == 0; });
+    left_out_pairs += intra_intersecting_reference(frame, [&](size_t i) { return skip[i] != 0; }).size();
+    for (int threads : {1, 3}) {
+      SCOPED_TRACE("seed " + std::to_string(seed) + ", threads " + std::to_string(threads));
+      const auto got = intra_object_distance(frame, {threads, nullptr, &skip});
+      EXPECT_EQ(got.intersecting, kept);
+      EXPECT_EQ(got.intersecting_known, (std::vector<std::uint8_t>{1, 1, 0, 1}));
+      IntersectingPairsOptions opts{threads, nullptr, true};
+      opts.intra_pairs = &got.intersecting;
+      opts.intra_known = &got.intersecting_known;
+      const auto merged = intersecting_pairs(frame, opts);
+      EXPECT_EQ(merged.pairs, all);
+      // The claimed objects are not searched again: fewer tests than a search of all.
+      EXPECT_LT(merged.exact_tests, intersecting_pairs(frame, {threads, nullptr, true}).exact_tests);
+    }
+  }
+  EXPECT_GT(left_out_pairs, 20u);
 }
 
 TEST(IntraDistance, SortedScanReferenceEqualsBruteForce) {
@@ -212,6 +286,7 @@ TEST(IntraStage2, CpuBoundsHoldAndResultsEqualBruteForce) {
   auto backend = make_cpu_self_voronoi_backend(2);
   for (const auto& [name, frame] : scenes()) {
     const auto ref = intra_object_distance_brute_force(frame);
+    const auto ref_pairs = intra_intersecting_reference(frame);
     const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
     const auto ring2 = ring2_upper_bounds(frame, 2);
     for (int grid : {8, 24, 64}) {
@@ -229,6 +304,7 @@ TEST(IntraStage2, CpuBoundsHoldAndResultsEqualBruteForce) {
         IntraDistanceOptions opts{threads, &vb};
         const auto got = intra_object_distance(frame, boxes, ring2, opts);
         expect_same_intra(got, ref, "voronoi cpu, threads " + std::to_string(threads));
+        expect_intersecting_pairs(got, frame, ref_pairs, "voronoi cpu, threads " + std::to_string(threads));
         expect_candidates_accounted(got.counters, name);
       }
     }
