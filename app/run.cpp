@@ -165,11 +165,12 @@ using StaticIntraCache = std::map<const Topology*, IntraObjectDistance>;
 /// a backend runs (at `grid` when given, else its own default), Stage III, for every object
 /// but the static ones already in `statics` (whose results are copied from there). Its times
 /// add to the frame's voronoi and exact times.
-/// `intersecting` and `intersecting_known` receive the intersecting pairs within the objects
-/// searched (IntraDistanceOutput), for intersecting_pairs().
+/// `intersecting` receives the intersecting pairs within the objects searched
+/// (IntraDistanceOutput), and `left_out` the static objects not searched, for
+/// intersecting_pairs().
 void run_intra(const Frame& frame, const FrameBoxes& boxes, VoronoiStage& voronoi, int grid,
                int threads, FrameResult& result, StaticIntraCache& statics,
-               std::vector<IntersectingPair>& intersecting, std::vector<std::uint8_t>& intersecting_known) {
+               std::vector<IntersectingPair>& intersecting, std::vector<std::uint8_t>& left_out) {
   Stopwatch sw;
   const std::size_t n = frame.objects.size();
   std::vector<std::uint8_t> known(n, 0);
@@ -211,7 +212,7 @@ void run_intra(const Frame& frame, const FrameBoxes& boxes, VoronoiStage& vorono
   }
   result.intra = std::move(d.per_object);
   intersecting = std::move(d.intersecting);
-  intersecting_known = std::move(d.intersecting_known);
+  left_out = std::move(known);
 }
 
 }  // namespace
@@ -283,7 +284,7 @@ void run(const Config& config) {
       result.time_ms.aabb = sw.elapsed_ms();
       InterDistanceOptions opts{info.threads, nullptr};
       std::vector<IntersectingPair> intra_pairs;
-      std::vector<std::uint8_t> intra_known;
+      std::vector<std::uint8_t> intra_left_out;
       VoronoiBounds bounds;
       if (voronoi.backend) {
         sw.restart();
@@ -298,7 +299,7 @@ void run(const Config& config) {
         result.time_ms.exact = d.exact_ms;
         result.counters = d.counters;
         result.inter = std::move(d.per_object);
-        run_intra(frame, boxes, voronoi, grid, info.threads, result, static_intra, intra_pairs, intra_known);
+        run_intra(frame, boxes, voronoi, grid, info.threads, result, static_intra, intra_pairs, intra_left_out);
       }
       // Discrete collisions (paper 3.2), then local penetration depth (3.3) from them; their
       // time counts as exact tests. The pairs within the objects that the intra-object
@@ -307,7 +308,7 @@ void run(const Config& config) {
       IntersectingPairsOptions ip_options{info.threads, opts.voronoi, true};
       if (want_distance) {
         ip_options.intra_pairs = &intra_pairs;
-        ip_options.intra_known = &intra_known;
+        ip_options.intra_skip = &intra_left_out;
       }
       IntersectingPairsOutput ip = intersecting_pairs(frame, boxes, ip_options);
       result.intersection_tests = ip.exact_tests;

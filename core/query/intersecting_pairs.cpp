@@ -58,9 +58,8 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
     add_chunks(from, into);
     needs_bvh[static_cast<size_t>(into)] = 1;
   }
-  const auto intra_known = [&](size_t i) {
-    return opts.intra_known != nullptr && i < opts.intra_known->size() && (*opts.intra_known)[i] != 0;
-  };
+  // Objects whose pairs within come from opts.intra_pairs.
+  const auto intra_known = [&](size_t i) { return opts.intra_pairs != nullptr && !marked(opts.intra_skip, i); };
   if (opts.intra) {
     for (size_t i = 0; i < n; ++i) {
       if (intra_known(i)) continue;
@@ -137,8 +136,7 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
     out.exact_tests += tests[k];
   }
   if (opts.intra && opts.intra_pairs != nullptr)
-    for (const IntersectingPair& p : *opts.intra_pairs)
-      if (intra_known(static_cast<size_t>(p.object_a))) out.pairs.push_back(p);
+    out.pairs.insert(out.pairs.end(), opts.intra_pairs->begin(), opts.intra_pairs->end());
   // Items are already in canonical order except that intra items follow the inter ones.
   std::sort(out.pairs.begin(), out.pairs.end());
   out.ms = sw.elapsed_ms();

@@ -19,12 +19,12 @@ struct IntersectingPairsOptions {
   /// intra-object search does not use them (D_l is a distance to other objects).
   const VoronoiBounds* voronoi = nullptr;
   bool intra = true;  ///< also list pairs within one object
-  /// With `intra`: pairs within objects that the caller already has, from the intra-object
-  /// distance (IntraDistanceOutput::intersecting, sorted), and per object 1 where they are
-  /// all of that object's pairs (IntraDistanceOutput::intersecting_known): those objects are
-  /// not searched again, and their pairs join the output as given. Null: search every object.
+  /// With `intra`: the pairs within objects that the intra-object distance already found
+  /// (IntraDistanceOutput::intersecting), all those of every object but the ones its `skip`
+  /// left out (`intra_skip`, the same mask, may be null). Those objects are not searched
+  /// again, and their pairs join the output as given. Null: search every object.
   const std::vector<IntersectingPair>* intra_pairs = nullptr;
-  const std::vector<std::uint8_t>* intra_known = nullptr;
+  const std::vector<std::uint8_t>* intra_skip = nullptr;
 };
 
 struct IntersectingPairsOutput {

@@ -283,8 +283,6 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
   // Both sides may evaluate a pair (a side skips it only when the other's search has ended).
   std::sort(out.intersecting.begin(), out.intersecting.end());
   out.intersecting.erase(std::unique(out.intersecting.begin(), out.intersecting.end()), out.intersecting.end());
-  out.intersecting_known.assign(n_obj, 0);
-  for (size_t i = 0; i < n_obj; ++i) out.intersecting_known[i] = marked(opts.skip, i) ? 0 : 1;
   parallel_for(n_obj, threads, [&](size_t i) { finish_object(out.per_object[i]); });
   out.exact_ms = sw.elapsed_ms();
   return out;

@@ -45,12 +45,10 @@ struct IntraDistanceOutput {
   std::vector<IntraObjectDistance> per_object;  ///< indexed by object id
   DistanceCounters counters;                    ///< the intra_* fields
   double exact_ms = 0;                          ///< BVHs, candidates and exact tests
-  /// Every intersecting pair of triangles sharing no vertex within each searched object (not
-  /// left out by `skip`), sorted: the exact tests meet every such pair (see
+  /// Every intersecting pair of triangles sharing no vertex within each object not left out
+  /// by `skip`, sorted, once each: the exact tests meet every such pair (see
   /// intra_object_distance()), so the intersecting pairs need not search for them again.
   std::vector<IntersectingPair> intersecting;
-  /// Per object, 1 when `intersecting` holds all of its pairs (it was searched).
-  std::vector<std::uint8_t> intersecting_known;
 };
 
 /// Stage III of the intra-object query. For each triangle f, a BVH range query around f's box
@@ -58,9 +56,9 @@ struct IntraDistanceOutput {
 /// sharing a vertex with f are skipped, with Stage II a triangle g is skipped when D_l(g)
 /// exceeds the bound, and the exact test runs on what is left.
 ///
-/// Every non-adjacent pair that intersects (distance 0) is evaluated, once: its boxes overlap,
-/// its separation bound is at most 0 and both D_l are at most 0, so neither side's bound culls
-/// it, and one side skips it only when the other evaluated it (SharedPairs; both sides may
+/// Every non-adjacent pair that intersects (distance 0) is evaluated: its boxes overlap, its
+/// separation bound is at most 0 and both D_l are at most 0, so neither side's bound culls it,
+/// and one side skips it only when the other evaluated it (SharedPairs; both sides may
 /// evaluate it). Those evaluated as intersecting are listed in `intersecting`, once each.
 ///
 /// Deterministic and thread-count independent: every unordered pair {f, g} is evaluated as

@@ -71,11 +71,10 @@ std::vector<IntersectingPair> intra_intersecting_reference(const Frame& frame) {
   return intra_intersecting_reference(frame, [](size_t) { return true; });
 }
 
-/// The search's intersecting pairs are the brute force's, and it claims every object.
-void expect_intersecting_pairs(const IntraDistanceOutput& got, const Frame& frame,
-                               const std::vector<IntersectingPair>& ref, const std::string& name) {
+/// The search's intersecting pairs are the brute force's.
+void expect_intersecting_pairs(const IntraDistanceOutput& got, const std::vector<IntersectingPair>& ref,
+                               const std::string& name) {
   EXPECT_EQ(got.intersecting, ref) << name;
-  EXPECT_EQ(got.intersecting_known, std::vector<std::uint8_t>(frame.objects.size(), 1)) << name;
 }
 
 TEST(IntraDistance, EqualsBruteForceOnAllScenesAndThreadCounts) {
@@ -88,7 +87,7 @@ TEST(IntraDistance, EqualsBruteForceOnAllScenesAndThreadCounts) {
     for (int threads : {1, 3}) {
       const auto got = intra_object_distance(frame, {threads});
       expect_same_intra(got, ref, name + ", threads " + std::to_string(threads));
-      expect_intersecting_pairs(got, frame, ref_pairs, name + ", threads " + std::to_string(threads));
+      expect_intersecting_pairs(got, ref_pairs, name + ", threads " + std::to_string(threads));
       EXPECT_LE(got.counters.intra_exact_tests, ref.counters.intra_exact_tests) << name;
       expect_candidates_accounted(got.counters, name);
       reused += got.counters.intra_reused;
@@ -114,12 +113,12 @@ TEST(IntraDistance, IntersectingPairsOfLargeObjectsOnManyThreadsAreListedOnce) {
     const auto ref = intra_intersecting_reference(frame);
     EXPECT_GT(ref.size(), 500u);
     for (int round = 0; round < 3; ++round)
-      expect_intersecting_pairs(intra_object_distance(frame, {3}), frame, ref, "seed " + std::to_string(seed));
+      expect_intersecting_pairs(intra_object_distance(frame, {3}), ref, "seed " + std::to_string(seed));
   }
 }
 
-// Objects left out (a caller's cached static objects) are not claimed: their pairs are missing
-// from the list, and the intersecting pairs search them itself. Together the lists equal the
+// Objects left out (a caller's cached static objects) are not searched: their pairs are missing
+// from the list, and the intersecting pairs search them itself (given the same mask). Together the lists equal the
 // brute force's, inter-object pairs included.
 TEST(IntraDistance, IntersectingPairsOfObjectsLeftOutComeFromTheirOwnSearch) {
   size_t left_out_pairs = 0;
@@ -137,10 +136,9 @@ TEST(IntraDistance, IntersectingPairsOfObjectsLeftOutComeFromTheirOwnSearch) {
       SCOPED_TRACE("seed " + std::to_string(seed) + ", threads " + std::to_string(threads));
       const auto got = intra_object_distance(frame, {threads, nullptr, &skip});
       EXPECT_EQ(got.intersecting, kept);
-      EXPECT_EQ(got.intersecting_known, (std::vector<std::uint8_t>{1, 1, 0, 1}));
       IntersectingPairsOptions opts{threads, nullptr, true};
       opts.intra_pairs = &got.intersecting;
-      opts.intra_known = &got.intersecting_known;
+      opts.intra_skip = &skip;
       const auto merged = intersecting_pairs(frame, opts);
       EXPECT_EQ(merged.pairs, all);
       // The claimed objects are not searched again: fewer tests than a search of all.
@@ -304,7 +302,7 @@ TEST(IntraStage2, CpuBoundsHoldAndResultsEqualBruteForce) {
         IntraDistanceOptions opts{threads, &vb};
         const auto got = intra_object_distance(frame, boxes, ring2, opts);
         expect_same_intra(got, ref, "voronoi cpu, threads " + std::to_string(threads));
-        expect_intersecting_pairs(got, frame, ref_pairs, "voronoi cpu, threads " + std::to_string(threads));
+        expect_intersecting_pairs(got, ref_pairs, "voronoi cpu, threads " + std::to_string(threads));
         expect_candidates_accounted(got.counters, name);
       }
     }
