@@ -673,16 +673,28 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
   std::vector<std::vector<Index>> node_max(from.objects.size());
   std::vector<std::vector<SweptTriangle>> swept(from.objects.size());
   std::vector<EndBoxes> ends(from.objects.size());
-  parallel_for(live.size(), threads, [&](size_t k) {
-    const size_t i = static_cast<size_t>(live[k]);
-    bvhs[i].build(sweep.triangles[i]);
-    const Topology& topo = *from.objects[i].topology;
-    owners[i] = ownership(topo, true);
-    pivot[i] = pivots(topo, owners[i]);
-    node_pivots[i] = bvhs[i].node_common_vertices(pivot[i]);
-    node_max[i] = bvhs[i].node_max_ids();
-    swept[i] = swept_triangles(from.objects[i], to.objects[i]);
-    ends[i] = EndBoxes::of(swept[i], bvhs[i], sweep.shares[i]);
+  // Per object, in two rounds of independent parts, so that a scene of one big object (a
+  // skirt and two legs) still keeps two threads busy: the hierarchy; the ownership and pivots;
+  // the swept triangles; then what needs the hierarchy.
+  parallel_for(3 * live.size(), threads, [&](size_t item) {
+    const size_t i = static_cast<size_t>(live[item / 3]);
+    if (item % 3 == 0) {
+      bvhs[i].build(sweep.triangles[i]);
+    } else if (item % 3 == 1) {
+      owners[i] = ownership(*from.objects[i].topology, true);
+      pivot[i] = pivots(*from.objects[i].topology, owners[i]);
+    } else {
+      swept[i] = swept_triangles(from.objects[i], to.objects[i]);
+    }
+  });
+  parallel_for(2 * live.size(), threads, [&](size_t item) {
+    const size_t i = static_cast<size_t>(live[item / 2]);
+    if (item % 2 == 0) {
+      node_pivots[i] = bvhs[i].node_common_vertices(pivot[i]);
+      node_max[i] = bvhs[i].node_max_ids();
+    } else {
+      ends[i] = EndBoxes::of(swept[i], bvhs[i], sweep.shares[i]);
+    }
   });
   out.aabb_ms = sw.elapsed_ms();
   sw.restart();
