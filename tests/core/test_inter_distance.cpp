@@ -195,6 +195,34 @@ TEST(TriangleBvh, AnyWithinAgreesWithAScanOfTheBoxes) {
   EXPECT_FALSE(TriangleBvh().any_within(boxes.objects[0], 1e300));
 }
 
+TEST(TriangleBvh, SubtreesOfSmallerIdsHoldOnlySmallerIds) {
+  // CCD's self search: from triangle f, passing over every subtree whose largest id is at most
+  // f still meets exactly the triangles of larger id whose boxes overlap f's (a scan of them).
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    const Frame frame = make_random_frame(seed, 2, 1.0, 2);
+    const FrameBoxes boxes = FrameBoxes::compute(frame, 1);
+    for (const auto& mine : boxes.triangles) {
+      TriangleBvh bvh;
+      bvh.build(mine);
+      const std::vector<Index> max_id = bvh.node_max_ids();
+      const auto n = static_cast<Index>(mine.size());
+      for (Index f = 0; f < n; ++f) {
+        std::vector<Index> met;
+        bvh.query_overlaps(mine[static_cast<size_t>(f)],
+                           [&](std::int32_t node) { return max_id[static_cast<size_t>(node)] <= f; },
+                           [&](Index g) {
+                             if (g > f) met.push_back(g);
+                           });
+        std::sort(met.begin(), met.end());
+        std::vector<Index> expect;
+        for (Index g = f + 1; g < n; ++g)
+          if (boxes_overlap(mine[static_cast<size_t>(f)], mine[static_cast<size_t>(g)])) expect.push_back(g);
+        ASSERT_EQ(met, expect) << "seed " << seed << " triangle " << f;
+      }
+    }
+  }
+}
+
 TEST(TriangleBvhBestFirst, VisitsExactlyThePairsWithinTheBound) {
   // A random frame's objects as hierarchies, a few probes into each, and a fixed bound: the
   // search must visit every (probe, triangle) whose boxes are within the bound, once, and
