@@ -1,12 +1,14 @@
 #include "core/broad_phase/triangle_bvh.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <numeric>
 
 namespace vproxq {
 
 void TriangleBvh::build(const std::vector<AABB>& boxes) {
   nodes_.clear();
+  node_min_ids_.clear();
   order_.resize(boxes.size());
   std::iota(order_.begin(), order_.end(), 0);
   leaf_boxes_.clear();
@@ -18,6 +20,32 @@ void TriangleBvh::build(const std::vector<AABB>& boxes) {
   build_node(0, 0, static_cast<std::int32_t>(boxes.size()), boxes, centroids);
   leaf_boxes_.resize(order_.size());
   for (size_t k = 0; k < order_.size(); ++k) leaf_boxes_[k] = boxes[static_cast<size_t>(order_[k])];
+  node_min_ids_.assign(nodes_.size(), std::numeric_limits<Index>::max());
+  // Children come after their parent in nodes_, so a reverse pass sees them first.
+  for (size_t n = nodes_.size(); n-- > 0;) {
+    const Node& node = nodes_[n];
+    Index& least = node_min_ids_[n];
+    if (node.count > 0) {
+      for (std::int32_t k = node.first; k < node.first + node.count; ++k)
+        least = std::min(least, order_[static_cast<size_t>(k)]);
+    } else {
+      least = std::min(node_min_ids_[static_cast<size_t>(node.first)], node_min_ids_[static_cast<size_t>(node.first) + 1]);
+    }
+  }
+}
+
+std::vector<double> TriangleBvh::node_min(const std::vector<double>& value) const {
+  std::vector<double> out(nodes_.size(), std::numeric_limits<double>::infinity());
+  for (size_t n = nodes_.size(); n-- > 0;) {  // children first, as above
+    const Node& node = nodes_[n];
+    if (node.count > 0) {
+      for (std::int32_t k = node.first; k < node.first + node.count; ++k)
+        out[n] = std::min(out[n], value[static_cast<size_t>(order_[static_cast<size_t>(k)])]);
+    } else {
+      out[n] = std::min(out[static_cast<size_t>(node.first)], out[static_cast<size_t>(node.first) + 1]);
+    }
+  }
+  return out;
 }
 
 std::vector<AABB> TriangleBvh::node_unions(const std::vector<AABB>& boxes) const {

@@ -82,7 +82,12 @@ class TriangleBvh {
     return false;
   }
 
-  class BestFirst;
+  /// The smallest triangle id in a node's subtree (a node index as skip() receives).
+  Index node_min_id(std::int32_t node) const { return node_min_ids_[static_cast<size_t>(node)]; }
+  /// Per node, the smallest value[t] over the triangles t of its subtree.
+  std::vector<double> node_min(const std::vector<double>& value) const;
+
+  class PairSearch;
 
  private:
   static constexpr int kLeafSize = 4;
@@ -96,6 +101,7 @@ class TriangleBvh {
   std::vector<Node> nodes_;
   std::vector<Index> order_;
   std::vector<AABB> leaf_boxes_;  ///< boxes in order_ order
+  std::vector<Index> node_min_ids_;  ///< per node, the smallest triangle id of its subtree
 };
 
 template <typename Bound, typename Visit, typename Skip>
@@ -151,92 +157,118 @@ void TriangleBvh::query_overlaps(const AABB& q, const Skip& skip, const Visit& v
   }
 }
 
-/// Best-first search of query boxes ("probes") against triangle hierarchies: run() expands
-/// (probe, node) entries in nondecreasing squared box distance over all probes added so far,
-/// while that distance is within bound(), which is re-read before each step (visit may lower
-/// it). A leaf's triangles are visited when the leaf comes up, each whose box is within the
-/// bound at that moment; so once the bound has come down to an answer d, no leaf farther than
-/// d is opened and no pair whose boxes are farther apart than d is visited. (Visiting a leaf's
-/// triangles at once, rather than queueing each, halves the queue's traffic at the cost of a
-/// few tests beyond the strict order.) Probes may be added between runs: a caller that adds
-/// them in nondecreasing order of a lower bound L on their boxes' distances and runs up to L
-/// before each addition keeps the global order. Equal distances are taken by probe number, then
-/// node, so the search is deterministic. clear() keeps the allocations.
-class TriangleBvh::BestFirst {
+/// Best-first search of the triangle pairs of pairs of hierarchies (a, b), descending both
+/// together: run() expands (pair, node of a, node of b) entries in nondecreasing squared box
+/// distance while that distance is within bound(), which is re-read before each step (visit may
+/// lower it). An entry splits the node with the larger box (the sum of its sides), never a
+/// leaf; two leaves are visited at once: each pair of their triangles whose boxes are within
+/// the bound at that moment. So once the bound has come down to an answer d, no pair of leaves
+/// farther apart than d is opened and no triangle pair whose boxes are farther apart than d is
+/// visited. Pairs of hierarchies may be added between runs: a caller that adds them in
+/// nondecreasing order of a lower bound L on their roots' distance and runs up to L before
+/// each addition keeps the global order. Equal distances are taken by pair number, then by the
+/// smallest triangle id under the node of a (a caller breaking ties on a's ids meets small ids
+/// first), then by node; so the search is deterministic. clear() keeps the allocations.
+///
+/// Descending a's hierarchy too, rather than each triangle of a into b's on its own, shares
+/// the upper levels among neighbouring triangles: see README, "Inter-object distance".
+class TriangleBvh::PairSearch {
  public:
   void clear() {
-    probes_.clear();
+    pairs_.clear();
     heap_.clear();
   }
-  /// Adds a probe (query box `box` into `bvh`) unless its root is farther than `bound`;
-  /// returns its index either way (probes are numbered in the order added).
-  std::size_t add(const TriangleBvh& bvh, const AABB& box, double bound) {
-    const std::size_t p = probes_.size();
-    probes_.push_back({&bvh, box});
-    if (!bvh.nodes_.empty()) {
-      const double d2 = box_distance_squared(box, bvh.nodes_[0].box);
-      if (d2 <= bound * bound) push({d2, static_cast<std::int32_t>(p), 0});
+  /// Adds the pair (a, b) unless a hierarchy is empty or their roots are farther apart than
+  /// `bound`; returns its index either way (pairs are numbered in the order added). Both must
+  /// outlive the search.
+  std::size_t add(const TriangleBvh& a, const TriangleBvh& b, double bound) {
+    const std::size_t p = pairs_.size();
+    pairs_.push_back({&a, &b});
+    if (!a.nodes_.empty() && !b.nodes_.empty()) {
+      const double d2 = box_distance_squared(a.nodes_[0].box, b.nodes_[0].box);
+      if (d2 <= bound * bound) push({d2, static_cast<std::int32_t>(p), 0, 0, a.node_min_ids_[0]});
     }
     return p;
   }
   /// Visits pairs as described above, stopping at the first entry beyond bound() or beyond
-  /// `until_d2` (squared); visit(probe, triangle, squared box distance). Entries of a probe
-  /// for which keep(probe) has become false are dropped unexpanded (e.g. a probe that can no
-  /// longer improve the answer).
-  template <typename Bound, typename Keep, typename Visit>
-  void run(const Bound& bound, const Keep& keep, const Visit& visit,
-           double until_d2 = std::numeric_limits<double>::infinity());
+  /// `until_d2` (squared). keep_node(pair, node of a) and keep_triangle(pair, triangle of a):
+  /// whether that subtree or triangle of a may still be part of a better pair (entries and
+  /// triangles for which they are false are dropped); visit(pair, triangle of a, triangle of b,
+  /// squared box distance).
+  template <typename Bound, typename KeepNode, typename KeepTriangle, typename Visit>
+  void run(const Bound& bound, const KeepNode& keep_node, const KeepTriangle& keep_triangle,
+           const Visit& visit, double until_d2 = std::numeric_limits<double>::infinity());
 
  private:
-  struct Probe {
-    const TriangleBvh* bvh;
-    AABB box;
+  struct Pair {
+    const TriangleBvh* a;
+    const TriangleBvh* b;
   };
   struct Entry {
     double d2;
-    std::int32_t probe;
-    std::int32_t node;
-    /// Ties by probe (a caller numbering its probes in a useful order, e.g. by triangle id
-    /// for a tie-break on ids, gets that order among equal distances), then by node.
+    std::int32_t pair;
+    std::int32_t node_a;
+    std::int32_t node_b;
+    Index rank;  ///< the smallest triangle id under node_a
     bool operator>(const Entry& o) const {
-      return d2 != o.d2 ? d2 > o.d2 : probe != o.probe ? probe > o.probe : node > o.node;
+      if (d2 != o.d2) return d2 > o.d2;
+      if (pair != o.pair) return pair > o.pair;
+      if (rank != o.rank) return rank > o.rank;
+      return node_a != o.node_a ? node_a > o.node_a : node_b > o.node_b;
     }
   };
   void push(const Entry& e) {
     heap_.push_back(e);
     std::push_heap(heap_.begin(), heap_.end(), std::greater<Entry>());
   }
-  std::vector<Probe> probes_;
+  std::vector<Pair> pairs_;
   std::vector<Entry> heap_;
 };
 
-template <typename Bound, typename Keep, typename Visit>
-void TriangleBvh::BestFirst::run(const Bound& bound, const Keep& keep, const Visit& visit,
-                                 double until_d2) {
+template <typename Bound, typename KeepNode, typename KeepTriangle, typename Visit>
+void TriangleBvh::PairSearch::run(const Bound& bound, const KeepNode& keep_node,
+                                  const KeepTriangle& keep_triangle, const Visit& visit,
+                                  double until_d2) {
+  auto size = [](const AABB& box) {
+    const Vec3 e = box.hi - box.lo;
+    return e.x() + e.y() + e.z();
+  };
   while (!heap_.empty()) {
     const double b = bound();
     const Entry e = heap_.front();
     if (e.d2 > b * b || e.d2 > until_d2) return;
     std::pop_heap(heap_.begin(), heap_.end(), std::greater<Entry>());
     heap_.pop_back();
-    if (!keep(static_cast<std::size_t>(e.probe))) continue;
-    const Probe& probe = probes_[static_cast<std::size_t>(e.probe)];
-    const TriangleBvh& bvh = *probe.bvh;
-    const Node& node = bvh.nodes_[static_cast<std::size_t>(e.node)];
-    if (node.count > 0) {
-      for (std::int32_t k = node.first; k < node.first + node.count; ++k) {
-        const double d2 = box_distance_squared(probe.box, bvh.leaf_boxes_[static_cast<std::size_t>(k)]);
-        const double bk = bound();
-        if (d2 <= bk * bk) visit(static_cast<std::size_t>(e.probe), bvh.order_[static_cast<std::size_t>(k)], d2);
+    const auto p = static_cast<std::size_t>(e.pair);
+    if (!keep_node(p, e.node_a)) continue;
+    const TriangleBvh& ta = *pairs_[p].a;
+    const TriangleBvh& tb = *pairs_[p].b;
+    const Node& na = ta.nodes_[static_cast<std::size_t>(e.node_a)];
+    const Node& nb = tb.nodes_[static_cast<std::size_t>(e.node_b)];
+    if (na.count > 0 && nb.count > 0) {
+      for (std::int32_t i = na.first; i < na.first + na.count; ++i) {
+        const Index t = ta.order_[static_cast<std::size_t>(i)];
+        if (!keep_triangle(p, t)) continue;
+        const AABB& box = ta.leaf_boxes_[static_cast<std::size_t>(i)];
+        for (std::int32_t k = nb.first; k < nb.first + nb.count; ++k) {
+          const double d2 = box_distance_squared(box, tb.leaf_boxes_[static_cast<std::size_t>(k)]);
+          const double bk = bound();
+          if (d2 <= bk * bk) visit(p, t, tb.order_[static_cast<std::size_t>(k)], d2);
+        }
       }
       continue;
     }
-    auto offer = [&](const AABB& box, std::int32_t child) {
-      const double d2 = box_distance_squared(probe.box, box);
-      if (d2 <= b * b) push({d2, e.probe, child});
-    };
-    offer(bvh.nodes_[static_cast<std::size_t>(node.first)].box, node.first);
-    offer(bvh.nodes_[static_cast<std::size_t>(node.first + 1)].box, node.first + 1);
+    if (nb.count > 0 || (na.count == 0 && size(na.box) >= size(nb.box))) {
+      for (std::int32_t c = na.first; c < na.first + 2; ++c) {
+        const double d2 = box_distance_squared(ta.nodes_[static_cast<std::size_t>(c)].box, nb.box);
+        if (d2 <= b * b) push({d2, e.pair, c, e.node_b, ta.node_min_ids_[static_cast<std::size_t>(c)]});
+      }
+    } else {
+      for (std::int32_t c = nb.first; c < nb.first + 2; ++c) {
+        const double d2 = box_distance_squared(na.box, tb.nodes_[static_cast<std::size_t>(c)].box);
+        if (d2 <= b * b) push({d2, e.pair, e.node_a, c, e.rank});
+      }
+    }
   }
 }
 

@@ -75,20 +75,22 @@ InterObjectDistance to_result(Index i, const Best& best) {
 
 /// Scratch space of one search, reused by a thread from object to object.
 struct SearchScratch {
-  TriangleBvh::BestFirst search;
-  std::vector<std::pair<Index, Index>> probe_pair;  ///< (other object j, own triangle) per probe
-  std::vector<std::pair<double, Index>> order;      ///< (squared lower bound, j) of the PNS
+  TriangleBvh::PairSearch search;
+  std::vector<Index> pair_object;               ///< the other object j of each pair searched
+  std::vector<std::pair<double, Index>> order;  ///< (squared lower bound, j) of the PNS
+  std::vector<double> node_lower;               ///< per node of i's BVH, the smallest D_l
 };
 
 /// Searches object i's PNS for its nearest object, updating `best`. Feature-level culling
-/// (paper 5.2.1): each triangle of i within the bound of an object j's box, and with Stage II
-/// whose lower bound D_l does not exceed it, is a probe into j's triangle BVH (the
-/// expanded-AABB overlap test). All probes are searched together, best first: triangle pairs
-/// are tested in nondecreasing box distance, so no pair whose boxes are farther apart than the
-/// answer is ever tested. Objects join in PNS order (by box distance, a lower bound on their
-/// probes' distances), each once the search has run up to its box distance. A pair (f, g) at
-/// distance d <= bound has D_l(f) <= d and D_l(g) <= d (each is at most d from some other
-/// object), so the D_l cuts lose nothing. `u` is D_u(O_i) from Stage I or II.
+/// (paper 5.2.1): the triangle pairs of i and each object j whose boxes lie within the bound
+/// (the expanded-AABB overlap test), and with Stage II whose lower bounds D_l do not exceed
+/// it, found by descending i's and j's triangle BVHs together. All of i's pairs of hierarchies
+/// are searched together, best first: triangle pairs are tested in nondecreasing box distance
+/// (a leaf pair's triangles at once), so no pair whose boxes are farther apart than the answer
+/// is ever tested. Objects join in PNS order (by box distance, a lower bound on their pairs'
+/// distances), each once the search has run up to its box distance. A pair (f, g) at distance
+/// d <= bound has D_l(f) <= d and D_l(g) <= d (each is at most d from some other object), so
+/// the D_l cuts lose nothing. `u` is D_u(O_i) from Stage I or II.
 void search_object(const Frame& frame, const FrameBoxes& boxes,
                    const std::vector<Index>& pns, Index i, double u, double slack,
                    const VoronoiBounds* voronoi, Best& best, SearchScratch& scratch,
@@ -96,15 +98,22 @@ void search_object(const Frame& frame, const FrameBoxes& boxes,
   const auto ui = static_cast<size_t>(i);
   const auto& tb_i = boxes.triangles[ui];
   const Object& oi = frame.objects[ui];
+  const TriangleBvh& bvh_i = boxes.bvh(ui);
   const double* low_i = voronoi ? voronoi->triangle_lower[ui].data() : nullptr;
+  if (voronoi) scratch.node_lower = bvh_i.node_min(voronoi->triangle_lower[ui]);
   auto bound = [&] { return std::min(u, best.distance) + slack; };
-  // A probe stays useful while its triangle may still be part of a better pair.
-  auto keep = [&](std::size_t p) {
-    const auto [j, ts] = scratch.probe_pair[p];
-    return !(low_i && low_i[ts] > bound()) && !best.contact_prunes(j, ts);
+  // A subtree or triangle of i stays useful while it may still be part of a better pair: its
+  // (smallest) D_l is within the bound, and after a contact, its (smallest) id can still win
+  // the tie-break.
+  auto keep_node = [&](std::size_t p, std::int32_t node) {
+    return !(low_i && scratch.node_lower[static_cast<size_t>(node)] > bound()) &&
+           !best.contact_prunes(scratch.pair_object[p], bvh_i.node_min_id(node));
   };
-  auto visit = [&](std::size_t p, Index to, double) {
-    const auto [j, ts] = scratch.probe_pair[p];
+  auto keep_triangle = [&](std::size_t p, Index ts) {
+    return !(low_i && low_i[ts] > bound()) && !best.contact_prunes(scratch.pair_object[p], ts);
+  };
+  auto visit = [&](std::size_t p, Index ts, Index to, double) {
+    const Index j = scratch.pair_object[p];
     if (voronoi && voronoi->triangle_lower[static_cast<size_t>(j)][static_cast<size_t>(to)] > bound()) return;
     if (best.contact_prunes(j, ts, to)) return;
     // Boxes within the bound, triangles provably farther apart (separation_bound.hpp).
@@ -117,12 +126,12 @@ void search_object(const Frame& frame, const FrameBoxes& boxes,
     ++counters.exact_tests;
   };
   scratch.search.clear();
-  scratch.probe_pair.clear();
+  scratch.pair_object.clear();
   // Objects in order of a lower bound on their distance: the box distance, or for boxes that
   // overlap the enclosure bound (enclosure_lower_bound(): objects inside a closed surface, or
-  // nested shells, whose boxes contain each other). Probes then join after the search has run up to
-  // their object's bound, which may exceed their box distances: the order of the visits
-  // changes, not what is visited within the final bound (each probe stays queued until run()
+  // nested shells, whose boxes contain each other). Pairs then join after the search has run
+  // up to their object's bound, which may exceed their box distances: the order of the visits
+  // changes, not what is visited within the final bound (each pair stays queued until run()
   // reaches it), and an object whose bound exceeds the answer is skipped whole.
   auto& order = scratch.order;
   order.clear();
@@ -134,21 +143,20 @@ void search_object(const Frame& frame, const FrameBoxes& boxes,
   std::sort(order.begin(), order.end());
   for (const auto& [dj2, j] : order) {
     const AABB& box_j = boxes.objects[static_cast<size_t>(j)];
-    scratch.search.run(bound, keep, visit, dj2);
+    scratch.search.run(bound, keep_node, keep_triangle, visit, dj2);
     const double b = bound();
     if (dj2 > b * b) break;  // sorted by that bound
     if (best.contact_prunes(j)) continue;
     ++counters.object_pns_pairs;
-    for (Index t = 0; t < static_cast<Index>(tb_i.size()); ++t) {
-      if ((low_i && low_i[t] > b) || best.contact_prunes(j, t)) continue;
-      const AABB& box_t = tb_i[static_cast<size_t>(t)];
-      if (box_distance_squared(box_t, box_j) > b * b) continue;
-      scratch.search.add(boxes.bvh(static_cast<size_t>(j)), box_t, b);
-      scratch.probe_pair.emplace_back(j, t);
-      ++counters.feature_pns;
-    }
+    // The feature-level PNS counter: i's triangles within the bound of j's box.
+    for (Index t = 0; t < static_cast<Index>(tb_i.size()); ++t)
+      if (!(low_i && low_i[t] > b) && !best.contact_prunes(j, t) &&
+          box_distance_squared(tb_i[static_cast<size_t>(t)], box_j) <= b * b)
+        ++counters.feature_pns;
+    scratch.search.add(bvh_i, boxes.bvh(static_cast<size_t>(j)), b);
+    scratch.pair_object.push_back(j);
   }
-  scratch.search.run(bound, keep, visit);
+  scratch.search.run(bound, keep_node, keep_triangle, visit);
 }
 
 }  // namespace

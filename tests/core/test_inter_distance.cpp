@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <set>
+#include <tuple>
 
 namespace vproxq {
 namespace {
@@ -223,47 +224,79 @@ TEST(TriangleBvh, SubtreesOfSmallerIdsHoldOnlySmallerIds) {
   }
 }
 
-TEST(TriangleBvhBestFirst, VisitsExactlyThePairsWithinTheBound) {
-  // A random frame's objects as hierarchies, a few probes into each, and a fixed bound: the
-  // search must visit every (probe, triangle) whose boxes are within the bound, once, and
-  // nothing else, also when probes are added between runs (in lower-bound order, after a run
-  // up to that lower bound).
-  const Frame frame = make_random_frame(7, 4, 1.2, 1);
+TEST(TriangleBvhPairSearch, VisitsExactlyThePairsWithinTheBound) {
+  // A random frame's objects as hierarchies, every ordered pair of them, and a fixed bound:
+  // the search must visit every (pair, triangle of a, triangle of b) whose boxes are within the
+  // bound, once, and nothing else, also when pairs are added between runs (in lower-bound
+  // order, after a run up to that lower bound). Then with triangles of a dropped: through
+  // keep_triangle by id and value, and through keep_node by node_min_id() and node_min(),
+  // which may drop a subtree only when every triangle in it is dropped too.
+  const Frame frame = make_random_frame(7, 5, 1.2, 1);
   const FrameBoxes boxes = FrameBoxes::compute(frame, 1);
-  std::vector<TriangleBvh> bvhs(frame.objects.size());
-  for (size_t i = 0; i < bvhs.size(); ++i) bvhs[i].build(boxes.triangles[i]);
-  struct P {
-    size_t object;
-    AABB box;
+  const size_t n = frame.objects.size();
+  std::vector<TriangleBvh> bvhs(n);
+  for (size_t i = 0; i < n; ++i) bvhs[i].build(boxes.triangles[i]);
+  std::vector<std::pair<size_t, size_t>> pairs;
+  for (size_t a = 0; a < n; ++a)
+    for (size_t b = 0; b < n; ++b)
+      if (a != b) pairs.emplace_back(a, b);
+  auto root_d2 = [&](const std::pair<size_t, size_t>& p) {
+    return box_distance_squared(boxes.objects[p.first], boxes.objects[p.second]);
   };
-  std::vector<P> probes;
-  for (size_t i = 0; i < bvhs.size(); ++i)
-    for (size_t t = 0; t < boxes.triangles[0].size(); t += 7) probes.push_back({i, boxes.triangles[0][t]});
-  std::sort(probes.begin(), probes.end(), [&](const P& a, const P& b) {
-    return box_distance_squared(a.box, boxes.objects[a.object]) < box_distance_squared(b.box, boxes.objects[b.object]);
-  });
-  for (double bound : {0.0, 0.05, 0.3, 10.0}) {
-    SCOPED_TRACE("bound " + std::to_string(bound));
-    std::multiset<std::pair<size_t, Index>> expected;
-    for (size_t p = 0; p < probes.size(); ++p)
-      for (Index t = 0; t < static_cast<Index>(boxes.triangles[probes[p].object].size()); ++t)
-        if (box_distance_squared(probes[p].box, boxes.triangles[probes[p].object][static_cast<size_t>(t)]) <= bound * bound)
-          expected.insert({p, t});
-    TriangleBvh::BestFirst search;
-    std::multiset<std::pair<size_t, Index>> got;
-    auto b = [&] { return bound; };
-    auto keep = [](size_t) { return true; };
-    auto visit = [&](size_t p, Index t, double d2) {
-      EXPECT_EQ(d2, box_distance_squared(probes[p].box, boxes.triangles[probes[p].object][static_cast<size_t>(t)]));
-      got.insert({p, t});
-    };
-    for (const P& pr : probes) {
-      search.run(b, keep, visit, box_distance_squared(pr.box, boxes.objects[pr.object]));
-      search.add(bvhs[pr.object], pr.box, bound);
-    }
-    search.run(b, keep, visit);
-    EXPECT_EQ(got, expected);
+  std::sort(pairs.begin(), pairs.end(), [&](const auto& x, const auto& y) { return root_d2(x) < root_d2(y); });
+  // Per object, a value per triangle (as D_l), and per node the smallest of them.
+  Rng rng(3);
+  std::vector<std::vector<double>> value(n);
+  std::vector<std::vector<double>> node_value(n);
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t t = 0; t < boxes.triangles[i].size(); ++t) value[i].push_back(rng.uniform(0, 1));
+    node_value[i] = bvhs[i].node_min(value[i]);
   }
+  using Key = std::tuple<size_t, Index, Index>;
+  size_t visited_max = 0;
+  for (double bound : {0.0, 0.05, 0.3, 10.0})
+    for (int drop = 0; drop < 3; ++drop) {
+      SCOPED_TRACE("bound " + std::to_string(bound) + " drop " + std::to_string(drop));
+      // drop 1: triangles of a with id above a limit of the pair; drop 2: those with value
+      // above one.
+      auto id_limit = [](size_t p) { return static_cast<Index>(p * 7 % 60); };
+      auto value_limit = [](size_t p) { return 0.1 + 0.8 * static_cast<double>(p % 5) / 4; };
+      auto kept = [&](size_t p, Index t) {
+        const size_t a = pairs[p].first;
+        return drop == 0 || (drop == 1 ? t <= id_limit(p) : value[a][static_cast<size_t>(t)] <= value_limit(p));
+      };
+      std::multiset<Key> expected;
+      for (size_t p = 0; p < pairs.size(); ++p) {
+        const auto [a, b] = pairs[p];
+        for (Index ta = 0; ta < static_cast<Index>(boxes.triangles[a].size()); ++ta)
+          for (Index tb = 0; tb < static_cast<Index>(boxes.triangles[b].size()); ++tb)
+            if (kept(p, ta) && box_distance_squared(boxes.triangles[a][static_cast<size_t>(ta)],
+                                                    boxes.triangles[b][static_cast<size_t>(tb)]) <= bound * bound)
+              expected.insert({p, ta, tb});
+      }
+      TriangleBvh::PairSearch search;
+      std::multiset<Key> got;
+      auto bnd = [&] { return bound; };
+      auto keep_node = [&](size_t p, std::int32_t node) {
+        const size_t a = pairs[p].first;
+        return drop == 0 || (drop == 1 ? bvhs[a].node_min_id(node) <= id_limit(p)
+                                       : node_value[a][static_cast<size_t>(node)] <= value_limit(p));
+      };
+      auto keep_triangle = [&](size_t p, Index t) { return kept(p, t); };
+      auto visit = [&](size_t p, Index ta, Index tb, double d2) {
+        const auto [a, b] = pairs[p];
+        EXPECT_EQ(d2, box_distance_squared(boxes.triangles[a][static_cast<size_t>(ta)], boxes.triangles[b][static_cast<size_t>(tb)]));
+        got.insert({p, ta, tb});
+      };
+      for (const auto& pr : pairs) {
+        search.run(bnd, keep_node, keep_triangle, visit, root_d2(pr));
+        search.add(bvhs[pr.first], bvhs[pr.second], bound);
+      }
+      search.run(bnd, keep_node, keep_triangle, visit);
+      EXPECT_EQ(got, expected);
+      visited_max = std::max(visited_max, got.size());
+    }
+  EXPECT_GT(visited_max, 1000u);  // the frame's objects do come within the bounds
 }
 
 TEST(ObjectBroadPhase, BoundsAndPnsAreConservative) {
