@@ -60,6 +60,24 @@ class TriangleBvh {
   template <typename Skip, typename Visit>
   void query_overlaps(const AABB& query, const Skip& skip, const Visit& visit) const;
 
+  /// A pair of nodes of one hierarchy: the same node (the pairs within its subtree), or two
+  /// nodes neither of which lies in the other's subtree (the pairs across them).
+  using NodePair = std::array<std::int32_t, 2>;
+  /// Calls visit(t, u) once for every unordered pair of distinct triangles of the node pair
+  /// (a, b) whose boxes overlap (closed boxes), descending both subtrees together: a pair of
+  /// nodes whose boxes overlap is split (the one with the larger box; within one node, into
+  /// its children's three pairs), without entering a pair (x, y) for which skip(x, y) is true
+  /// (x == y: the pairs within x). Within one object, this replaces a search per triangle:
+  /// neighbouring triangles share the upper levels (README, "Continuous collision detection").
+  template <typename Skip, typename Visit>
+  void self_overlaps(const NodePair& pair, const Skip& skip, const Visit& visit) const;
+  /// The node pairs that self_overlaps() from the root, (0, 0), goes through first, expanded
+  /// (as it does, with the same skip) until each pair holds at most `max_triangles` triangles
+  /// in all or is a single leaf: running self_overlaps() on each of them visits what it visits
+  /// from the root, so they are units of parallel work. Empty for an empty hierarchy.
+  template <typename Skip>
+  std::vector<NodePair> self_overlap_pairs(std::int32_t max_triangles, const Skip& skip) const;
+
   /// Whether some triangle's box lies within `bound` of `query` (squared box distance at most
   /// bound^2); stops at the first.
   bool any_within(const AABB& query, double bound) const {
@@ -155,6 +173,95 @@ void TriangleBvh::query_overlaps(const AABB& q, const Skip& skip, const Visit& v
     stack[top++] = node.first + 1;
     stack[top++] = node.first;
   }
+}
+
+template <typename Skip, typename Visit>
+void TriangleBvh::self_overlaps(const NodePair& start, const Skip& skip, const Visit& visit) const {
+  if (nodes_.empty()) return;
+  auto size = [](const AABB& box) {
+    const Vec3 e = box.hi - box.lo;
+    return e.x() + e.y() + e.z();
+  };
+  thread_local std::vector<NodePair> stack;  // reused: called per unit of work
+  stack.clear();
+  stack.push_back(start);
+  while (!stack.empty()) {
+    const auto [a, b] = stack.back();
+    stack.pop_back();
+    const Node& na = nodes_[static_cast<size_t>(a)];
+    const Node& nb = nodes_[static_cast<size_t>(b)];
+    if (a == b) {
+      if (skip(a, a)) continue;
+      if (na.count > 0) {
+        for (std::int32_t k = na.first; k < na.first + na.count; ++k)
+          for (std::int32_t m = k + 1; m < na.first + na.count; ++m)
+            if (boxes_overlap(leaf_boxes_[static_cast<size_t>(k)], leaf_boxes_[static_cast<size_t>(m)]))
+              visit(order_[static_cast<size_t>(k)], order_[static_cast<size_t>(m)]);
+        continue;
+      }
+      stack.push_back({na.first, na.first + 1});
+      stack.push_back({na.first + 1, na.first + 1});
+      stack.push_back({na.first, na.first});
+      continue;
+    }
+    if (!boxes_overlap(na.box, nb.box) || skip(a, b)) continue;
+    if (na.count > 0 && nb.count > 0) {
+      for (std::int32_t k = na.first; k < na.first + na.count; ++k)
+        for (std::int32_t m = nb.first; m < nb.first + nb.count; ++m)
+          if (boxes_overlap(leaf_boxes_[static_cast<size_t>(k)], leaf_boxes_[static_cast<size_t>(m)]))
+            visit(order_[static_cast<size_t>(k)], order_[static_cast<size_t>(m)]);
+      continue;
+    }
+    if (nb.count > 0 || (na.count == 0 && size(na.box) >= size(nb.box))) {
+      stack.push_back({na.first + 1, b});
+      stack.push_back({na.first, b});
+    } else {
+      stack.push_back({a, nb.first + 1});
+      stack.push_back({a, nb.first});
+    }
+  }
+}
+
+template <typename Skip>
+std::vector<TriangleBvh::NodePair> TriangleBvh::self_overlap_pairs(std::int32_t max_triangles, const Skip& skip) const {
+  std::vector<NodePair> out;
+  if (nodes_.empty()) return out;
+  // Triangles per subtree; children come after their parent, so a reverse pass sees them first.
+  std::vector<std::int32_t> count(nodes_.size());
+  for (size_t n = nodes_.size(); n-- > 0;) {
+    const Node& node = nodes_[n];
+    count[n] = node.count > 0 ? node.count : count[static_cast<size_t>(node.first)] + count[static_cast<size_t>(node.first) + 1];
+  }
+  auto size = [](const AABB& box) {
+    const Vec3 e = box.hi - box.lo;
+    return e.x() + e.y() + e.z();
+  };
+  // The same expansion as self_overlaps(), in the same order, stopping at small pairs.
+  std::vector<NodePair> stack{{0, 0}};
+  while (!stack.empty()) {
+    const auto [a, b] = stack.back();
+    stack.pop_back();
+    const Node& na = nodes_[static_cast<size_t>(a)];
+    const Node& nb = nodes_[static_cast<size_t>(b)];
+    if (a == b ? skip(a, a) : !boxes_overlap(na.box, nb.box) || skip(a, b)) continue;
+    const std::int32_t held = a == b ? count[static_cast<size_t>(a)] : count[static_cast<size_t>(a)] + count[static_cast<size_t>(b)];
+    if (held <= max_triangles || (na.count > 0 && nb.count > 0)) {
+      out.push_back({a, b});
+      continue;
+    }
+    if (a == b) {
+      stack.push_back({na.first, na.first + 1});
+      stack.push_back({na.first + 1, na.first + 1});
+      stack.push_back({na.first, na.first});
+    } else if (nb.count > 0 || (na.count == 0 && size(na.box) >= size(nb.box))) {
+      stack.push_back({na.first + 1, b});
+      stack.push_back({na.first, b});
+    } else {
+      stack.push_back({a, nb.first + 1});
+      stack.push_back({a, nb.first});
+    }
+  }
+  return out;
 }
 
 /// Best-first search of the triangle pairs of pairs of hierarchies (a, b), descending both

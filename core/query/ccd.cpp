@@ -670,7 +670,6 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
   std::vector<Ownership> owners(from.objects.size());
   std::vector<std::vector<Face>> pivot(from.objects.size());
   std::vector<std::vector<std::array<Index, 3>>> node_pivots(from.objects.size());
-  std::vector<std::vector<Index>> node_max(from.objects.size());
   std::vector<std::vector<SweptTriangle>> swept(from.objects.size());
   std::vector<EndBoxes> ends(from.objects.size());
   // Per object, in two rounds of independent parts, so that a scene of one big object (a
@@ -691,7 +690,6 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
     const size_t i = static_cast<size_t>(live[item / 2]);
     if (item % 2 == 0) {
       node_pivots[i] = bvhs[i].node_common_vertices(pivot[i]);
-      node_max[i] = bvhs[i].node_max_ids();
     } else {
       ends[i] = EndBoxes::of(swept[i], bvhs[i], sweep.shares[i]);
     }
@@ -713,15 +711,49 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
                                                 [&](Index f) { near[p].push_back(f); });
     std::sort(near[p].begin(), near[p].end());
   });
+  // Within one object, the BVH is descended against itself (TriangleBvh::self_overlaps()),
+  // from node pairs that split the search into units of work. A pair of subtrees is passed
+  // over when a pivot is common to all their triangles (no primitive pair to test below:
+  // pivots()) or when they stay apart at both ends of the step.
+  auto self_apart = [&](Index i, std::int32_t a, std::int32_t b) {
+    const auto ui = static_cast<size_t>(i);
+    const auto ua = static_cast<size_t>(a), ub = static_cast<size_t>(b);
+    if (TriangleBvh::adjacent_subtree(node_pivots[ui][ua], node_pivots[ui][ub])) return true;
+    if (a == b) return false;
+    const EndBoxes& e = ends[ui];
+    const double gap = 2 * std::min(sweep.pair_margin(i, i), e.node_share[ua] + e.node_share[ub]);
+    const AABB &a_start = e.node_start[ua], &a_end = e.node_end[ua];
+    const AABB &b_start = e.node_start[ub], &b_end = e.node_end[ub];
+    if (apart_at_both_ends(a_start, a_end, b_start, b_end, gap)) return true;
+    // Subtrees moving fast relative to each other (by more than twice the larger one's size):
+    // the axes perpendicular to that motion, as in swept_apart().
+    const Vec3 r = 0.5 * (((a_end.lo + a_end.hi) - (a_start.lo + a_start.hi)) - ((b_end.lo + b_end.hi) - (b_start.lo + b_start.hi)));
+    const double size = std::max((a_start.hi - a_start.lo).maxCoeff(), (b_start.hi - b_start.lo).maxCoeff());
+    if (!(r.squaredNorm() > 4 * size * size)) return false;
+    const auto w = perpendicular_axes(r);
+    return boxes_apart_along(a_start, a_end, b_start, b_end, w[0], gap) ||
+           boxes_apart_along(a_start, a_end, b_start, b_end, w[1], gap);
+  };
+  std::vector<std::vector<TriangleBvh::NodePair>> self_pairs(object_pairs.size());
+  parallel_for(object_pairs.size(), threads, [&](size_t p) {
+    const Index i = object_pairs[p].first;
+    if (i != object_pairs[p].second) return;
+    self_pairs[p] = bvhs[static_cast<size_t>(i)].self_overlap_pairs(
+        kChunk, [&](std::int32_t a, std::int32_t b) { return self_apart(i, a, b); });
+  });
   struct Task {
     Index i, j;
-    std::size_t pair;    ///< index into object_pairs (and near)
-    Index first, last;  ///< within object i's triangles (i == j), else within near[pair]
+    std::size_t pair;    ///< index into object_pairs (and near, self_pairs)
+    Index first, last;  ///< within self_pairs[pair] (i == j), else within near[pair]
   };
   std::vector<Task> tasks;
   for (size_t p = 0; p < object_pairs.size(); ++p) {
     const auto [i, j] = object_pairs[p];
-    const Index n = i == j ? from.objects[static_cast<size_t>(i)].num_triangles() : static_cast<Index>(near[p].size());
+    if (i == j) {  // a task per node pair (of at most kChunk triangles)
+      for (Index q = 0; q < static_cast<Index>(self_pairs[p].size()); ++q) tasks.push_back({i, j, p, q, q + 1});
+      continue;
+    }
+    const auto n = static_cast<Index>(near[p].size());
     for (Index t = 0; t < n; t += kChunk) tasks.push_back({i, j, p, t, std::min(n, t + kChunk)});
   }
   const Tester tester(from, to);
@@ -905,22 +937,52 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
       return;
     }
 
+    // A triangle pair whose swept boxes overlap (within one object, f < g): counted, tried as
+    // wholes, then its primitive pairs are culled; those left are tested now, or with Stage
+    // II listed for it and tested after it.
+    auto candidate_pair = [&](Index f, Index g) {
+      if (self && TriangleBvh::adjacent_subtree(pivot[static_cast<size_t>(j)][static_cast<size_t>(g)],
+                                                pivot[static_cast<size_t>(i)][static_cast<size_t>(f)]))
+        return;  // a common pivot: no primitive pair to test
+      ++hits.counters.triangle_pairs;
+      const double apart_gap = 2 * pair_margin(f, g);
+      // Two triangles of one object that share a vertex are never apart as wholes (both
+      // boxes and both projections on any axis contain that vertex's), so only their
+      // primitive pairs are tried (88% of the pairs that reach cull_pair() on the funnel
+      // scene's frames 10-19, 94% on cloth-ball's).
+      const bool touching = self && Adjacency::share_vertex(oi.topology->faces[static_cast<size_t>(f)],
+                                                             oj.topology->faces[static_cast<size_t>(g)]);
+      if (!touching && (apart_at_both_ends(ends_i.start[static_cast<size_t>(f)], ends_i.end[static_cast<size_t>(f)],
+                                           ends_j.start[static_cast<size_t>(g)], ends_j.end[static_cast<size_t>(g)], apart_gap) ||
+                        swept_apart(swept_i[static_cast<size_t>(f)], swept_j[static_cast<size_t>(g)], apart_gap))) {
+        ++hits.counters.separated_pairs;
+        return;
+      }
+      const std::uint16_t mask = cull_pair(f, g);
+      if (mask == 0) return;
+      if (stage2)
+        candidates[k].push_back({f, g, mask});
+      else
+        run_tests(f, g, mask);
+    };
+
+    if (self) {
+      const TriangleBvh& bvh = bvhs[static_cast<size_t>(i)];
+      const auto apart = [&](std::int32_t a, std::int32_t b) { return self_apart(i, a, b); };
+      for (Index q = task.first; q < task.last; ++q)
+        bvh.self_overlaps(self_pairs[task.pair][static_cast<size_t>(q)], apart,
+                          [&](Index f, Index g) { candidate_pair(std::min(f, g), std::max(f, g)); });
+      return;
+    }
     for (Index q = task.first; q < task.last; ++q) {
-      const Index f = self ? q : near[task.pair][static_cast<size_t>(q)];
+      const Index f = near[task.pair][static_cast<size_t>(q)];
       const AABB& fb = tb_i[static_cast<size_t>(f)];
       const SweptTriangle& swept_f = swept_i[static_cast<size_t>(f)];
       const AABB& f_start = ends_i.start[static_cast<size_t>(f)];
       const AABB& f_end = ends_i.end[static_cast<size_t>(f)];
       const double f_share = ends_i.share[static_cast<size_t>(f)];
       const Vec3 f_motion = 0.5 * ((f_end.lo + f_end.hi) - (f_start.lo + f_start.hi));  // its box center's
-      const Face& f_pivots = pivot[static_cast<size_t>(i)][static_cast<size_t>(f)];
       const auto subtree_apart = [&](std::int32_t node) {
-        // Within one object each unordered pair is met from its smaller id (below), so a
-        // subtree of smaller ids only holds pairs met from the other side: about half of each
-        // descent.
-        if (self && node_max[static_cast<size_t>(j)][static_cast<size_t>(node)] <= f) return true;
-        if (self && TriangleBvh::adjacent_subtree(node_pivots[static_cast<size_t>(j)][static_cast<size_t>(node)], f_pivots))
-          return true;  // no primitive pair to test with any triangle below (pivots())
         const AABB& n_start = ends_j.node_start[static_cast<size_t>(node)];
         const AABB& n_end = ends_j.node_end[static_cast<size_t>(node)];
         const double apart_gap = 2 * std::min(object_margin, f_share + ends_j.node_share[static_cast<size_t>(node)]);
@@ -933,33 +995,7 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
         return boxes_apart_along(f_start, f_end, n_start, n_end, w[0], apart_gap) ||
                boxes_apart_along(f_start, f_end, n_start, n_end, w[1], apart_gap);
       };
-      bvhs[static_cast<size_t>(j)].query_overlaps(fb, subtree_apart, [&](Index g) {
-        if (self && g <= f) return;  // each unordered pair once
-        if (self && TriangleBvh::adjacent_subtree(pivot[static_cast<size_t>(j)][static_cast<size_t>(g)], f_pivots))
-          return;  // a common pivot: no primitive pair to test
-        ++hits.counters.triangle_pairs;
-        const double apart_gap = 2 * pair_margin(f, g);
-        // Two triangles of one object that share a vertex are never apart as wholes (both
-        // boxes and both projections on any axis contain that vertex's), so only their
-        // primitive pairs are tried (88% of the pairs that reach cull_pair() on the funnel
-        // scene's frames 10-19, 94% on cloth-ball's).
-        const bool touching = self && Adjacency::share_vertex(oi.topology->faces[static_cast<size_t>(f)],
-                                                               oj.topology->faces[static_cast<size_t>(g)]);
-        if (!touching && (apart_at_both_ends(f_start, f_end, ends_j.start[static_cast<size_t>(g)],
-                                             ends_j.end[static_cast<size_t>(g)], apart_gap) ||
-                          swept_apart(swept_f, swept_j[static_cast<size_t>(g)], apart_gap))) {
-          ++hits.counters.separated_pairs;
-          return;
-        }
-        // With Stage II, the pairs with a primitive pair to test are listed for it (the pairs
-        // whose primitive pairs are all culled here need no voxels), and tested after it.
-        const std::uint16_t mask = cull_pair(f, g);
-        if (mask == 0) return;
-        if (stage2)
-          candidates[k].push_back({f, g, mask});
-        else
-          run_tests(f, g, mask);
-      });
+      bvhs[static_cast<size_t>(j)].query_overlaps(fb, subtree_apart, [&](Index g) { candidate_pair(f, g); });
     }
   };
   parallel_for(tasks.size(), threads, [&](size_t k) { process(k, false); });
