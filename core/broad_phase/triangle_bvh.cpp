@@ -66,21 +66,6 @@ std::vector<AABB> TriangleBvh::node_unions(const std::vector<AABB>& boxes) const
   return out;
 }
 
-std::vector<Index> TriangleBvh::node_max_ids() const {
-  std::vector<Index> out(nodes_.size(), kNoIndex);
-  // Children come after their parent in nodes_, so a reverse pass sees them first.
-  for (size_t n = nodes_.size(); n-- > 0;) {
-    const Node& node = nodes_[n];
-    if (node.count > 0) {
-      for (std::int32_t k = node.first; k < node.first + node.count; ++k)
-        out[n] = std::max(out[n], order_[static_cast<size_t>(k)]);
-    } else {
-      out[n] = std::max(out[static_cast<size_t>(node.first)], out[static_cast<size_t>(node.first) + 1]);
-    }
-  }
-  return out;
-}
-
 std::vector<std::array<Index, 3>> TriangleBvh::node_common_vertices(const std::vector<Face>& faces) const {
   constexpr std::array<Index, 3> kNone{kNoIndex, kNoIndex, kNoIndex};
   // The vertices of `a` that `keep` also holds, ascending.

@@ -46,10 +46,6 @@ class TriangleBvh {
   /// The box of a node (the union of its triangles' boxes), by the index skip() receives.
   const AABB& node_box(std::int32_t node) const { return nodes_[static_cast<size_t>(node)].box; }
 
-  /// Per node, the largest triangle id in its subtree: a search that pairs f only with
-  /// triangles of larger id (each unordered pair once) can pass over a subtree whose largest
-  /// id is at most f.
-  std::vector<Index> node_max_ids() const;
 
   /// The union, per node, of another box per triangle (`boxes[t]`, e.g. the triangles' boxes
   /// at one end of a CCD step), indexed as the nodes are for query_overlaps().

@@ -196,30 +196,50 @@ TEST(TriangleBvh, AnyWithinAgreesWithAScanOfTheBoxes) {
   EXPECT_FALSE(TriangleBvh().any_within(boxes.objects[0], 1e300));
 }
 
-TEST(TriangleBvh, SubtreesOfSmallerIdsHoldOnlySmallerIds) {
-  // CCD's self search: from triangle f, passing over every subtree whose largest id is at most
-  // f still meets exactly the triangles of larger id whose boxes overlap f's (a scan of them).
+TEST(TriangleBvh, SelfOverlapsVisitEveryOverlappingPairOnce) {
+  // CCD's search within one object: descending the hierarchy against itself must visit every
+  // unordered pair of distinct triangles whose boxes overlap, once, and nothing else; from the
+  // root or from the node pairs of self_overlap_pairs() alike. With a skip that passes over
+  // the node pairs all of whose ids are at least K (by node_min_id()), every pair with an id
+  // below K must still be visited, and some pairs of larger ids are not.
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
     const Frame frame = make_random_frame(seed, 2, 1.0, 2);
     const FrameBoxes boxes = FrameBoxes::compute(frame, 1);
     for (const auto& mine : boxes.triangles) {
       TriangleBvh bvh;
       bvh.build(mine);
-      const std::vector<Index> max_id = bvh.node_max_ids();
       const auto n = static_cast<Index>(mine.size());
-      for (Index f = 0; f < n; ++f) {
-        std::vector<Index> met;
-        bvh.query_overlaps(mine[static_cast<size_t>(f)],
-                           [&](std::int32_t node) { return max_id[static_cast<size_t>(node)] <= f; },
-                           [&](Index g) {
-                             if (g > f) met.push_back(g);
-                           });
-        std::sort(met.begin(), met.end());
-        std::vector<Index> expect;
+      using PairSet = std::multiset<std::pair<Index, Index>>;
+      auto record = [](PairSet& set) {
+        return [&set](Index f, Index g) { set.insert({std::min(f, g), std::max(f, g)}); };
+      };
+      auto none = [](std::int32_t, std::int32_t) { return false; };
+      PairSet expect;
+      for (Index f = 0; f < n; ++f)
         for (Index g = f + 1; g < n; ++g)
-          if (boxes_overlap(mine[static_cast<size_t>(f)], mine[static_cast<size_t>(g)])) expect.push_back(g);
-        ASSERT_EQ(met, expect) << "seed " << seed << " triangle " << f;
+          if (boxes_overlap(mine[static_cast<size_t>(f)], mine[static_cast<size_t>(g)])) expect.insert({f, g});
+      PairSet from_root, from_pairs;
+      bvh.self_overlaps({0, 0}, none, record(from_root));
+      const auto starts = bvh.self_overlap_pairs(16, none);
+      for (const auto& sp : starts) bvh.self_overlaps(sp, none, record(from_pairs));
+      ASSERT_EQ(from_root, expect) << "seed " << seed;
+      ASSERT_EQ(from_pairs, expect) << "seed " << seed;
+      EXPECT_GT(starts.size(), 4u);
+      const Index k = n / 3;
+      auto large = [&](std::int32_t a, std::int32_t b) { return bvh.node_min_id(a) >= k && bvh.node_min_id(b) >= k; };
+      PairSet skipped_root, skipped_pairs;
+      bvh.self_overlaps({0, 0}, large, record(skipped_root));
+      for (const auto& sp : bvh.self_overlap_pairs(16, large)) bvh.self_overlaps(sp, large, record(skipped_pairs));
+      EXPECT_EQ(skipped_root, skipped_pairs) << "seed " << seed;
+      PairSet small_expect, small_got;
+      for (const auto& p : expect)
+        if (p.first < k) small_expect.insert(p);
+      for (const auto& p : skipped_root) {
+        EXPECT_EQ(expect.count(p), 1u) << p.first << " " << p.second;
+        if (p.first < k) small_got.insert(p);
       }
+      EXPECT_EQ(small_got, small_expect) << "seed " << seed;
+      EXPECT_LT(skipped_root.size(), expect.size()) << "seed " << seed;
     }
   }
 }
