@@ -714,14 +714,17 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
   // Within one object, the BVH is descended against itself (TriangleBvh::self_overlaps()),
   // from node pairs that split the search into units of work. A pair of subtrees is passed
   // over when a pivot is common to all their triangles (no primitive pair to test below:
-  // pivots()) or when they stay apart at both ends of the step.
+  // pivots()) or when they stay apart at both ends of the step (or, moving fast relative to
+  // each other, along the axes perpendicular to that motion).
+  std::vector<double> self_margin(from.objects.size(), 0.0);
+  for (Index i : live) self_margin[static_cast<size_t>(i)] = sweep.pair_margin(i, i);
   auto self_apart = [&](Index i, std::int32_t a, std::int32_t b) {
     const auto ui = static_cast<size_t>(i);
     const auto ua = static_cast<size_t>(a), ub = static_cast<size_t>(b);
     if (TriangleBvh::adjacent_subtree(node_pivots[ui][ua], node_pivots[ui][ub])) return true;
     if (a == b) return false;
     const EndBoxes& e = ends[ui];
-    const double gap = 2 * std::min(sweep.pair_margin(i, i), e.node_share[ua] + e.node_share[ub]);
+    const double gap = 2 * std::min(self_margin[ui], e.node_share[ua] + e.node_share[ub]);
     const AABB &a_start = e.node_start[ua], &a_end = e.node_end[ua];
     const AABB &b_start = e.node_start[ub], &b_end = e.node_end[ub];
     if (apart_at_both_ends(a_start, a_end, b_start, b_end, gap)) return true;
