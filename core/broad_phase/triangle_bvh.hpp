@@ -121,14 +121,20 @@ class TriangleBvh {
 template <typename Bound, typename Visit, typename Skip>
 void TriangleBvh::query(const AABB& q, const Bound& bound, const Visit& visit, const Skip& skip) const {
   if (nodes_.empty()) return;
-  std::int32_t stack[64];
+  // Each entry keeps the node's squared distance, computed once when its parent ordered its
+  // children, and compared again with the bound (which may have dropped) when it comes up.
+  struct Entry {
+    std::int32_t node;
+    double d2;
+  };
+  Entry stack[64];
   int top = 0;
-  stack[top++] = 0;
+  stack[top++] = {0, box_distance_squared(q, nodes_[0].box)};
   while (top > 0) {
-    const std::int32_t at = stack[--top];
+    const auto [at, d2] = stack[--top];
     const Node& node = nodes_[static_cast<size_t>(at)];
     double b = bound();
-    if (box_distance_squared(q, node.box) > b * b || skip(at)) continue;
+    if (d2 > b * b || skip(at)) continue;
     if (node.count > 0) {
       for (std::int32_t k = node.first; k < node.first + node.count; ++k) {
         const double d2 = box_distance_squared(q, leaf_boxes_[static_cast<size_t>(k)]);
@@ -142,11 +148,11 @@ void TriangleBvh::query(const AABB& q, const Bound& bound, const Visit& visit, c
     const double dr = box_distance_squared(q, nodes_[static_cast<size_t>(r)].box);
     // Push the farther child first so the nearer one is searched first.
     if (dl <= dr) {
-      stack[top++] = r;
-      stack[top++] = l;
+      stack[top++] = {r, dr};
+      stack[top++] = {l, dl};
     } else {
-      stack[top++] = l;
-      stack[top++] = r;
+      stack[top++] = {l, dl};
+      stack[top++] = {r, dr};
     }
   }
 }
