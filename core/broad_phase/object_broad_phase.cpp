@@ -202,6 +202,9 @@ ObjectBroadPhase object_broad_phase(const Frame& frame, const FrameBoxes& boxes,
   if (live.size() < 2) return out;
   const std::array<SortedAxis, 3> axes{SortedAxis(live, boxes.objects, 0), SortedAxis(live, boxes.objects, 1),
                                        SortedAxis(live, boxes.objects, 2)};
+  // The walks below read the triangle BVHs; a large one is built here on all threads rather
+  // than by the first walk that needs it, on one.
+  boxes.build_bvhs(threads, [&](size_t i) { return boxes.triangles[i].size() >= FrameBoxes::kLargeBvh; });
 
   parallel_for(live.size(), threads, [&](size_t li) {
     const Index i = live[li];

@@ -34,9 +34,12 @@ struct FrameBoxes {
   /// Object i's BVH over triangles[i], built on first use (safe from several threads at once)
   /// and then shared by every query of the frame, and by copies of this FrameBoxes.
   const TriangleBvh& bvh(std::size_t i) const;
-  /// Builds the BVHs of the objects for which want(i) holds, on `threads` threads.
+  /// Builds the BVHs of the objects for which want(i) holds, on `threads` threads: those of
+  /// at least kLargeBvh triangles one after the other, each on all threads (a scene of one big
+  /// cloth kept one thread busy), then the others in parallel, each on one.
   template <typename Want>
   void build_bvhs(int threads, const Want& want) const;
+  static constexpr std::size_t kLargeBvh = 4096;
   /// The BVH of the boxes of the objects with triangles, built on first use (like bvh()).
   const ObjectBoxTree& object_tree() const;
 
@@ -70,6 +73,9 @@ inline const TriangleBvh& FrameBoxes::bvh(std::size_t i) const {
 
 template <typename Want>
 void FrameBoxes::build_bvhs(int threads, const Want& want) const {
+  for (std::size_t i = 0; i < triangles.size(); ++i)
+    if (triangles[i].size() >= kLargeBvh && want(i))
+      std::call_once(bvh_cache->once[i], [&] { bvh_cache->bvhs[i].build(triangles[i], threads); });
   parallel_for(triangles.size(), threads, [&](std::size_t i) {
     if (want(i)) bvh(i);
   });

@@ -1,30 +1,66 @@
 #include "core/broad_phase/triangle_bvh.hpp"
 
+#include "core/parallel.hpp"
+
 #include <algorithm>
 #include <limits>
 #include <numeric>
 
 namespace vproxq {
 
-void TriangleBvh::build(const std::vector<AABB>& boxes) {
+struct TriangleBvh::SubtreeSizes {
+  /// (n, nodes of a subtree over n triangles): each depth holds ranges of at most two sizes
+  /// (n / 2^d rounded down or up), so there are few.
+  std::vector<std::pair<std::int32_t, std::int32_t>> nodes;
+
+  explicit SubtreeSizes(std::int32_t n) { count(n); }
+  std::int32_t of(std::int32_t n) const {
+    for (const auto& [size, c] : nodes)
+      if (size == n) return c;
+    return 0;  // not reached: every size of the build was counted
+  }
+
+ private:
+  std::int32_t count(std::int32_t n) {
+    for (const auto& [size, c] : nodes)
+      if (size == n) return c;
+    const std::int32_t c = n <= kLeafSize ? 1 : 1 + count(n / 2) + count(n - n / 2);
+    nodes.emplace_back(n, c);
+    return c;
+  }
+};
+
+void TriangleBvh::build(const std::vector<AABB>& boxes, int threads) {
   nodes_.clear();
   node_min_ids_.clear();
   order_.resize(boxes.size());
   std::iota(order_.begin(), order_.end(), 0);
   leaf_boxes_.clear();
   if (boxes.empty()) return;
+  const auto n = static_cast<std::int32_t>(boxes.size());
   std::vector<Vec3> centroids(boxes.size());
   for (size_t t = 0; t < boxes.size(); ++t) centroids[t] = boxes[t].center();
-  nodes_.reserve(2 * boxes.size() / kLeafSize + 2);
-  nodes_.push_back({});
-  build_node(0, 0, static_cast<std::int32_t>(boxes.size()), boxes, centroids);
+  const SubtreeSizes sizes(n);
+  nodes_.assign(static_cast<size_t>(sizes.of(n)), Node{});
+  if (threads <= 1) {
+    build_node(0, 0, n, 1, boxes, centroids, sizes, nullptr, 0);
+  } else {
+    // The top levels here, down to subtrees of at most n / (2 threads) triangles; those in
+    // parallel (disjoint ranges of order_ and of nodes_).
+    std::vector<Pending> pending;
+    build_node(0, 0, n, 1, boxes, centroids, sizes, &pending, std::max<std::int32_t>(kLeafSize, n / (2 * threads)));
+    parallel_for(pending.size(), threads, [&](size_t k) {
+      const Pending& p = pending[k];
+      build_node(p.slot, p.begin, p.end, p.next, boxes, centroids, sizes, nullptr, 0);
+    });
+  }
   leaf_boxes_.resize(order_.size());
   for (size_t k = 0; k < order_.size(); ++k) leaf_boxes_[k] = boxes[static_cast<size_t>(order_[k])];
   node_min_ids_.assign(nodes_.size(), std::numeric_limits<Index>::max());
   // Children come after their parent in nodes_, so a reverse pass sees them first.
-  for (size_t n = nodes_.size(); n-- > 0;) {
-    const Node& node = nodes_[n];
-    Index& least = node_min_ids_[n];
+  for (size_t m = nodes_.size(); m-- > 0;) {
+    const Node& node = nodes_[m];
+    Index& least = node_min_ids_[m];
     if (node.count > 0) {
       for (std::int32_t k = node.first; k < node.first + node.count; ++k)
         least = std::min(least, order_[static_cast<size_t>(k)]);
@@ -106,8 +142,13 @@ std::vector<std::array<Index, 3>> TriangleBvh::node_common_vertices(const std::v
 
 // Depth stays below 64 (the query stack size): each split halves the range, and ranges of at
 // most kLeafSize are leaves, so depth <= log2(2^31) + 1.
-void TriangleBvh::build_node(std::int32_t slot, std::int32_t begin, std::int32_t end,
-                             const std::vector<AABB>& boxes, const std::vector<Vec3>& centroids) {
+void TriangleBvh::build_node(std::int32_t slot, std::int32_t begin, std::int32_t end, std::int32_t next,
+                             const std::vector<AABB>& boxes, const std::vector<Vec3>& centroids,
+                             const SubtreeSizes& sizes, std::vector<Pending>* pending, std::int32_t grain) {
+  if (pending && end - begin <= grain) {
+    pending->push_back({slot, begin, end, next});
+    return;
+  }
   Node node;
   for (std::int32_t k = begin; k < end; ++k) node.box.extend(boxes[static_cast<size_t>(order_[static_cast<size_t>(k)])]);
   if (end - begin <= kLeafSize) {
@@ -127,15 +168,13 @@ void TriangleBvh::build_node(std::int32_t slot, std::int32_t begin, std::int32_t
     const double ca = centroids[static_cast<size_t>(a)][axis], cbv = centroids[static_cast<size_t>(b)][axis];
     return ca < cbv || (ca == cbv && a < b);
   });
-  // Children are an adjacent pair, allocated before recursing.
-  const std::int32_t left = static_cast<std::int32_t>(nodes_.size());
-  nodes_.push_back({});
-  nodes_.push_back({});
-  node.first = left;
+  // Children are an adjacent pair; the left subtree's descendants follow them, then the right's
+  // (the depth-first order in which a serial build allocated them).
+  node.first = next;
   node.count = 0;
   nodes_[static_cast<size_t>(slot)] = node;
-  build_node(left, begin, mid, boxes, centroids);
-  build_node(left + 1, mid, end, boxes, centroids);
+  build_node(next, begin, mid, next + 2, boxes, centroids, sizes, pending, grain);
+  build_node(next + 1, mid, end, next + 2 + sizes.of(mid - begin) - 1, boxes, centroids, sizes, pending, grain);
 }
 
 }  // namespace vproxq

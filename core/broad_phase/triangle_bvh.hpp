@@ -15,8 +15,10 @@ namespace vproxq {
 class TriangleBvh {
  public:
   /// Builds over `boxes` (triangle t has boxes[t]): median split on the longest axis of the
-  /// centroids, up to kLeafSize triangles per leaf. Deterministic.
-  void build(const std::vector<AABB>& boxes);
+  /// centroids, up to kLeafSize triangles per leaf. Deterministic: with `threads` > 1 the
+  /// subtrees below the top levels are built in parallel, into the same nodes at the same
+  /// places (a subtree's place follows from the sizes of the ranges before it).
+  void build(const std::vector<AABB>& boxes, int threads = 1);
 
   /// Calls visit(t, squared box distance) for every triangle t whose box is within the bound
   /// of `query`, nearest subtrees first. `bound()` is re-read as the search goes (visit may
@@ -43,6 +45,8 @@ class TriangleBvh {
   }
 
   bool empty() const { return nodes_.empty(); }
+  /// Number of nodes; node indices run from 0 (the root) to node_count() - 1.
+  std::int32_t node_count() const { return static_cast<std::int32_t>(nodes_.size()); }
   /// The box of a node (the union of its triangles' boxes), by the index skip() receives.
   const AABB& node_box(std::int32_t node) const { return nodes_[static_cast<size_t>(node)].box; }
 
@@ -110,8 +114,18 @@ class TriangleBvh {
     std::int32_t first;  ///< leaf: first index into order_; inner: left child (right = left+1)
     std::int32_t count;  ///< leaf: number of triangles; inner: 0
   };
-  void build_node(std::int32_t slot, std::int32_t begin, std::int32_t end,
-                  const std::vector<AABB>& boxes, const std::vector<Vec3>& centroids);
+  /// Nodes of a subtree over n triangles, for every n its ranges split into (n / 2 and the
+  /// rest, down to kLeafSize): filled in before a build, read during it.
+  struct SubtreeSizes;
+  /// Builds the subtree of triangles order_[begin, end) into node `slot`; its children, if
+  /// any, go to `next` and next + 1, their descendants after them in depth-first order. With
+  /// `pending`, a subtree of at most `grain` triangles is left to be built later (recorded).
+  struct Pending {
+    std::int32_t slot, begin, end, next;
+  };
+  void build_node(std::int32_t slot, std::int32_t begin, std::int32_t end, std::int32_t next,
+                  const std::vector<AABB>& boxes, const std::vector<Vec3>& centroids,
+                  const SubtreeSizes& sizes, std::vector<Pending>* pending, std::int32_t grain);
   std::vector<Node> nodes_;
   std::vector<Index> order_;
   std::vector<AABB> leaf_boxes_;  ///< boxes in order_ order

@@ -675,10 +675,14 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
   // Per object, in two rounds of independent parts, so that a scene of one big object (a
   // skirt and two legs) still keeps two threads busy: the hierarchy; the ownership and pivots;
   // the swept triangles; then what needs the hierarchy.
+  // A hierarchy of at least FrameBoxes::kLargeBvh triangles is built first, on all threads.
+  for (Index i : live)
+    if (sweep.triangles[static_cast<size_t>(i)].size() >= FrameBoxes::kLargeBvh)
+      bvhs[static_cast<size_t>(i)].build(sweep.triangles[static_cast<size_t>(i)], threads);
   parallel_for(3 * live.size(), threads, [&](size_t item) {
     const size_t i = static_cast<size_t>(live[item / 3]);
     if (item % 3 == 0) {
-      bvhs[i].build(sweep.triangles[i]);
+      if (sweep.triangles[i].size() < FrameBoxes::kLargeBvh) bvhs[i].build(sweep.triangles[i]);
     } else if (item % 3 == 1) {
       owners[i] = ownership(*from.objects[i].topology, true);
       pivot[i] = pivots(*from.objects[i].topology, owners[i]);

@@ -196,6 +196,40 @@ TEST(TriangleBvh, AnyWithinAgreesWithAScanOfTheBoxes) {
   EXPECT_FALSE(TriangleBvh().any_within(boxes.objects[0], 1e300));
 }
 
+TEST(TriangleBvh, ParallelBuildGivesTheSameHierarchy) {
+  // Built on several threads, a hierarchy has the same nodes at the same places as built on
+  // one (the searches' visiting order, and so their counters, depend on it): the boxes of
+  // two blobs (8,704 triangles), and some of their first ones.
+  const Frame frame = make_random_frame(5, 1, 1.0, 5);
+  const FrameBoxes boxes = FrameBoxes::compute(frame, 1);
+  std::vector<AABB> all = boxes.triangles[0];
+  const Frame small = make_random_frame(6, 1, 1.0, 3);
+  const FrameBoxes small_boxes = FrameBoxes::compute(small, 1);
+  all.insert(all.end(), small_boxes.triangles[0].begin(), small_boxes.triangles[0].end());
+  ASSERT_EQ(all.size(), 8704u);
+  for (size_t n : {all.size(), all.size() - 1, size_t{4099}, size_t{17}, size_t{5}, size_t{1}}) {
+    const std::vector<AABB> part(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(n));
+    TriangleBvh one;
+    one.build(part);
+    for (int threads : {2, 3, 4, 7}) {
+      SCOPED_TRACE("n " + std::to_string(n) + " threads " + std::to_string(threads));
+      TriangleBvh many;
+      many.build(part, threads);
+      ASSERT_EQ(many.node_count(), one.node_count());
+      for (std::int32_t k = 0; k < one.node_count(); ++k) {
+        ASSERT_EQ(many.node_box(k).lo, one.node_box(k).lo) << "node " << k;
+        ASSERT_EQ(many.node_box(k).hi, one.node_box(k).hi) << "node " << k;
+        ASSERT_EQ(many.node_min_id(k), one.node_min_id(k)) << "node " << k;
+      }
+      std::vector<Index> met_one, met_many;
+      const AABB& q = part[n / 2];
+      one.query(q, [] { return 0.05; }, [&](Index t, double) { met_one.push_back(t); });
+      many.query(q, [] { return 0.05; }, [&](Index t, double) { met_many.push_back(t); });
+      EXPECT_EQ(met_many, met_one);
+    }
+  }
+}
+
 TEST(TriangleBvh, SelfOverlapsVisitEveryOverlappingPairOnce) {
   // CCD's search within one object: descending the hierarchy against itself must visit every
   // unordered pair of distinct triangles whose boxes overlap, once, and nothing else; from the
