@@ -50,7 +50,6 @@ class TriangleBvh {
   /// The box of a node (the union of its triangles' boxes), by the index skip() receives.
   const AABB& node_box(std::int32_t node) const { return nodes_[static_cast<size_t>(node)].box; }
 
-
   /// The union, per node, of another box per triangle (`boxes[t]`, e.g. the triangles' boxes
   /// at one end of a CCD step), indexed as the nodes are for query_overlaps().
   std::vector<AABB> node_unions(const std::vector<AABB>& boxes) const;
@@ -117,12 +116,13 @@ class TriangleBvh {
   /// Nodes of a subtree over n triangles, for every n its ranges split into (n / 2 and the
   /// rest, down to kLeafSize): filled in before a build, read during it.
   struct SubtreeSizes;
-  /// Builds the subtree of triangles order_[begin, end) into node `slot`; its children, if
-  /// any, go to `next` and next + 1, their descendants after them in depth-first order. With
-  /// `pending`, a subtree of at most `grain` triangles is left to be built later (recorded).
+  /// A subtree left for later by build_node(): its arguments.
   struct Pending {
     std::int32_t slot, begin, end, next;
   };
+  /// Builds the subtree of triangles order_[begin, end) into node `slot`; its children, if
+  /// any, go to `next` and next + 1, their descendants after them in depth-first order. With
+  /// `pending`, a subtree of at most `grain` triangles is left to be built later (recorded).
   void build_node(std::int32_t slot, std::int32_t begin, std::int32_t end, std::int32_t next,
                   const std::vector<AABB>& boxes, const std::vector<Vec3>& centroids,
                   const SubtreeSizes& sizes, std::vector<Pending>* pending, std::int32_t grain);
@@ -151,9 +151,9 @@ void TriangleBvh::query(const AABB& q, const Bound& bound, const Visit& visit, c
     if (d2 > b * b || skip(at)) continue;
     if (node.count > 0) {
       for (std::int32_t k = node.first; k < node.first + node.count; ++k) {
-        const double d2 = box_distance_squared(q, leaf_boxes_[static_cast<size_t>(k)]);
+        const double dt = box_distance_squared(q, leaf_boxes_[static_cast<size_t>(k)]);
         b = bound();
-        if (d2 <= b * b) visit(order_[static_cast<size_t>(k)], d2);
+        if (dt <= b * b) visit(order_[static_cast<size_t>(k)], dt);
       }
       continue;
     }
