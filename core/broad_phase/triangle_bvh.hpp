@@ -126,6 +126,33 @@ class TriangleBvh {
   void build_node(std::int32_t slot, std::int32_t begin, std::int32_t end, std::int32_t next,
                   const std::vector<AABB>& boxes, const std::vector<Vec3>& centroids,
                   const SubtreeSizes& sizes, std::vector<Pending>* pending, std::int32_t grain);
+  /// Whether a descent of the node pair (na, nb), not two leaves, splits na: the node with
+  /// the larger box (the sum of its sides), never a leaf.
+  static bool splits_first(const Node& na, const Node& nb) {
+    auto size = [](const AABB& box) {
+      const Vec3 e = box.hi - box.lo;
+      return e.x() + e.y() + e.z();
+    };
+    return nb.count > 0 || (na.count == 0 && size(na.box) >= size(nb.box));
+  }
+  /// Pushes the node pairs that self_overlaps() splits the pair (a, b) into (not two leaves
+  /// nor one leaf with itself), in the order it takes them (the last pushed first).
+  void push_self_split(const NodePair& pair, std::vector<NodePair>& stack) const {
+    const auto [a, b] = pair;
+    const Node& na = nodes_[static_cast<size_t>(a)];
+    const Node& nb = nodes_[static_cast<size_t>(b)];
+    if (a == b) {
+      stack.push_back({na.first, na.first + 1});
+      stack.push_back({na.first + 1, na.first + 1});
+      stack.push_back({na.first, na.first});
+    } else if (splits_first(na, nb)) {
+      stack.push_back({na.first + 1, b});
+      stack.push_back({na.first, b});
+    } else {
+      stack.push_back({a, nb.first + 1});
+      stack.push_back({a, nb.first});
+    }
+  }
   std::vector<Node> nodes_;
   std::vector<Index> order_;
   std::vector<AABB> leaf_boxes_;  ///< boxes in order_ order
@@ -194,10 +221,6 @@ void TriangleBvh::query_overlaps(const AABB& q, const Skip& skip, const Visit& v
 template <typename Skip, typename Visit>
 void TriangleBvh::self_overlaps(const NodePair& start, const Skip& skip, const Visit& visit) const {
   if (nodes_.empty()) return;
-  auto size = [](const AABB& box) {
-    const Vec3 e = box.hi - box.lo;
-    return e.x() + e.y() + e.z();
-  };
   thread_local std::vector<NodePair> stack;  // reused: called per unit of work
   stack.clear();
   stack.push_back(start);
@@ -215,9 +238,7 @@ void TriangleBvh::self_overlaps(const NodePair& start, const Skip& skip, const V
               visit(order_[static_cast<size_t>(k)], order_[static_cast<size_t>(m)]);
         continue;
       }
-      stack.push_back({na.first, na.first + 1});
-      stack.push_back({na.first + 1, na.first + 1});
-      stack.push_back({na.first, na.first});
+      push_self_split({a, b}, stack);
       continue;
     }
     if (!boxes_overlap(na.box, nb.box) || skip(a, b)) continue;
@@ -228,13 +249,7 @@ void TriangleBvh::self_overlaps(const NodePair& start, const Skip& skip, const V
             visit(order_[static_cast<size_t>(k)], order_[static_cast<size_t>(m)]);
       continue;
     }
-    if (nb.count > 0 || (na.count == 0 && size(na.box) >= size(nb.box))) {
-      stack.push_back({na.first + 1, b});
-      stack.push_back({na.first, b});
-    } else {
-      stack.push_back({a, nb.first + 1});
-      stack.push_back({a, nb.first});
-    }
+    push_self_split({a, b}, stack);
   }
 }
 
@@ -248,10 +263,6 @@ std::vector<TriangleBvh::NodePair> TriangleBvh::self_overlap_pairs(std::int32_t 
     const Node& node = nodes_[n];
     count[n] = node.count > 0 ? node.count : count[static_cast<size_t>(node.first)] + count[static_cast<size_t>(node.first) + 1];
   }
-  auto size = [](const AABB& box) {
-    const Vec3 e = box.hi - box.lo;
-    return e.x() + e.y() + e.z();
-  };
   // The same expansion as self_overlaps(), in the same order, stopping at small pairs.
   std::vector<NodePair> stack{{0, 0}};
   while (!stack.empty()) {
@@ -265,17 +276,7 @@ std::vector<TriangleBvh::NodePair> TriangleBvh::self_overlap_pairs(std::int32_t 
       out.push_back({a, b});
       continue;
     }
-    if (a == b) {
-      stack.push_back({na.first, na.first + 1});
-      stack.push_back({na.first + 1, na.first + 1});
-      stack.push_back({na.first, na.first});
-    } else if (nb.count > 0 || (na.count == 0 && size(na.box) >= size(nb.box))) {
-      stack.push_back({na.first + 1, b});
-      stack.push_back({na.first, b});
-    } else {
-      stack.push_back({a, nb.first + 1});
-      stack.push_back({a, nb.first});
-    }
+    push_self_split({a, b}, stack);
   }
   return out;
 }
@@ -352,10 +353,6 @@ template <typename Bound, typename KeepNode, typename KeepTriangle, typename Vis
 void TriangleBvh::PairSearch::run(const Bound& bound, const KeepNode& keep_node,
                                   const KeepTriangle& keep_triangle, const Visit& visit,
                                   double until_d2) {
-  auto size = [](const AABB& box) {
-    const Vec3 e = box.hi - box.lo;
-    return e.x() + e.y() + e.z();
-  };
   while (!heap_.empty()) {
     const double b = bound();
     const Entry e = heap_.front();
@@ -381,7 +378,7 @@ void TriangleBvh::PairSearch::run(const Bound& bound, const KeepNode& keep_node,
       }
       continue;
     }
-    if (nb.count > 0 || (na.count == 0 && size(na.box) >= size(nb.box))) {
+    if (splits_first(na, nb)) {
       for (std::int32_t c = na.first; c < na.first + 2; ++c) {
         const double d2 = box_distance_squared(ta.nodes_[static_cast<std::size_t>(c)].box, nb.box);
         if (d2 <= b * b) push({d2, e.pair, c, e.node_b, ta.node_min_ids_[static_cast<std::size_t>(c)]});
