@@ -84,6 +84,20 @@ std::vector<double> TriangleBvh::node_min(const std::vector<double>& value) cons
   return out;
 }
 
+std::vector<double> TriangleBvh::node_max(const std::vector<double>& value) const {
+  std::vector<double> out(nodes_.size(), -std::numeric_limits<double>::infinity());
+  for (size_t n = nodes_.size(); n-- > 0;) {  // children first, as above
+    const Node& node = nodes_[n];
+    if (node.count > 0) {
+      for (std::int32_t k = node.first; k < node.first + node.count; ++k)
+        out[n] = std::max(out[n], value[static_cast<size_t>(order_[static_cast<size_t>(k)])]);
+    } else {
+      out[n] = std::max(out[static_cast<size_t>(node.first)], out[static_cast<size_t>(node.first) + 1]);
+    }
+  }
+  return out;
+}
+
 std::vector<AABB> TriangleBvh::node_unions(const std::vector<AABB>& boxes) const {
   std::vector<AABB> out(nodes_.size());
   // Children come after their parent in nodes_, so a reverse pass sees them first.

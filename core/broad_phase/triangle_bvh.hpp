@@ -75,7 +75,21 @@ class TriangleBvh {
   /// in all or is a single leaf: running self_overlaps() on each of them visits what it visits
   /// from the root, so they are units of parallel work. Empty for an empty hierarchy.
   template <typename Skip>
-  std::vector<NodePair> self_overlap_pairs(std::int32_t max_triangles, const Skip& skip) const;
+  std::vector<NodePair> self_overlap_pairs(std::int32_t max_triangles, const Skip& skip) const {
+    return self_pairs_below(max_triangles, overlap_test(skip));
+  }
+
+  /// The descent of self_overlaps() with another test: from the node pair `start`, enters a
+  /// pair (x, y) only where enter(x, y) is true (x == y: the pairs within x), splitting it as
+  /// self_overlaps() does, and calls visit(t, u, box of t, box of u) once for every unordered
+  /// pair of distinct triangles of each pair of leaves it enters (a leaf with itself
+  /// included), whatever their boxes.
+  template <typename Enter, typename Visit>
+  void descend_self(const NodePair& start, const Enter& enter, const Visit& visit) const;
+  /// self_overlap_pairs() for descend_self() with `enter`: running descend_self() with the
+  /// same enter on each pair returned visits what it visits from the root.
+  template <typename Enter>
+  std::vector<NodePair> self_pairs_below(std::int32_t max_triangles, const Enter& enter) const;
 
   /// Whether some triangle's box lies within `bound` of `query` (squared box distance at most
   /// bound^2); stops at the first.
@@ -103,6 +117,8 @@ class TriangleBvh {
   Index node_min_id(std::int32_t node) const { return node_min_ids_[static_cast<size_t>(node)]; }
   /// Per node, the smallest value[t] over the triangles t of its subtree.
   std::vector<double> node_min(const std::vector<double>& value) const;
+  /// Per node, the largest value[t] over the triangles t of its subtree.
+  std::vector<double> node_max(const std::vector<double>& value) const;
 
   class PairSearch;
 
@@ -134,6 +150,15 @@ class TriangleBvh {
       return e.x() + e.y() + e.z();
     };
     return nb.count > 0 || (na.count == 0 && size(na.box) >= size(nb.box));
+  }
+  /// self_overlaps()'s test of a node pair for descend_self(): overlapping boxes (x != y),
+  /// and not skipped.
+  template <typename Skip>
+  auto overlap_test(const Skip& skip) const {
+    return [this, &skip](std::int32_t x, std::int32_t y) {
+      return x == y ? !skip(x, x)
+                    : boxes_overlap(nodes_[static_cast<size_t>(x)].box, nodes_[static_cast<size_t>(y)].box) && !skip(x, y);
+    };
   }
   /// Pushes the node pairs that self_overlaps() splits the pair (a, b) into (not two leaves
   /// nor one leaf with itself), in the order it takes them (the last pushed first).
@@ -220,6 +245,13 @@ void TriangleBvh::query_overlaps(const AABB& q, const Skip& skip, const Visit& v
 
 template <typename Skip, typename Visit>
 void TriangleBvh::self_overlaps(const NodePair& start, const Skip& skip, const Visit& visit) const {
+  descend_self(start, overlap_test(skip), [&](Index t, Index u, const AABB& bt, const AABB& bu) {
+    if (boxes_overlap(bt, bu)) visit(t, u);
+  });
+}
+
+template <typename Enter, typename Visit>
+void TriangleBvh::descend_self(const NodePair& start, const Enter& enter, const Visit& visit) const {
   if (nodes_.empty()) return;
   thread_local std::vector<NodePair> stack;  // reused: called per unit of work
   stack.clear();
@@ -227,34 +259,22 @@ void TriangleBvh::self_overlaps(const NodePair& start, const Skip& skip, const V
   while (!stack.empty()) {
     const auto [a, b] = stack.back();
     stack.pop_back();
+    if (!enter(a, b)) continue;
     const Node& na = nodes_[static_cast<size_t>(a)];
     const Node& nb = nodes_[static_cast<size_t>(b)];
-    if (a == b) {
-      if (skip(a, a)) continue;
-      if (na.count > 0) {
-        for (std::int32_t k = na.first; k < na.first + na.count; ++k)
-          for (std::int32_t m = k + 1; m < na.first + na.count; ++m)
-            if (boxes_overlap(leaf_boxes_[static_cast<size_t>(k)], leaf_boxes_[static_cast<size_t>(m)]))
-              visit(order_[static_cast<size_t>(k)], order_[static_cast<size_t>(m)]);
-        continue;
-      }
-      push_self_split({a, b}, stack);
-      continue;
-    }
-    if (!boxes_overlap(na.box, nb.box) || skip(a, b)) continue;
-    if (na.count > 0 && nb.count > 0) {
+    if (na.count > 0 && (a == b || nb.count > 0)) {
       for (std::int32_t k = na.first; k < na.first + na.count; ++k)
-        for (std::int32_t m = nb.first; m < nb.first + nb.count; ++m)
-          if (boxes_overlap(leaf_boxes_[static_cast<size_t>(k)], leaf_boxes_[static_cast<size_t>(m)]))
-            visit(order_[static_cast<size_t>(k)], order_[static_cast<size_t>(m)]);
+        for (std::int32_t m = a == b ? k + 1 : nb.first; m < nb.first + nb.count; ++m)
+          visit(order_[static_cast<size_t>(k)], order_[static_cast<size_t>(m)], leaf_boxes_[static_cast<size_t>(k)],
+                leaf_boxes_[static_cast<size_t>(m)]);
       continue;
     }
     push_self_split({a, b}, stack);
   }
 }
 
-template <typename Skip>
-std::vector<TriangleBvh::NodePair> TriangleBvh::self_overlap_pairs(std::int32_t max_triangles, const Skip& skip) const {
+template <typename Enter>
+std::vector<TriangleBvh::NodePair> TriangleBvh::self_pairs_below(std::int32_t max_triangles, const Enter& enter) const {
   std::vector<NodePair> out;
   if (nodes_.empty()) return out;
   // Triangles per subtree; children come after their parent, so a reverse pass sees them first.
@@ -263,14 +283,14 @@ std::vector<TriangleBvh::NodePair> TriangleBvh::self_overlap_pairs(std::int32_t 
     const Node& node = nodes_[n];
     count[n] = node.count > 0 ? node.count : count[static_cast<size_t>(node.first)] + count[static_cast<size_t>(node.first) + 1];
   }
-  // The same expansion as self_overlaps(), in the same order, stopping at small pairs.
+  // The same expansion as descend_self(), in the same order, stopping at small pairs.
   std::vector<NodePair> stack{{0, 0}};
   while (!stack.empty()) {
     const auto [a, b] = stack.back();
     stack.pop_back();
+    if (!enter(a, b)) continue;
     const Node& na = nodes_[static_cast<size_t>(a)];
     const Node& nb = nodes_[static_cast<size_t>(b)];
-    if (a == b ? skip(a, a) : !boxes_overlap(na.box, nb.box) || skip(a, b)) continue;
     const std::int32_t held = a == b ? count[static_cast<size_t>(a)] : count[static_cast<size_t>(a)] + count[static_cast<size_t>(b)];
     if (held <= max_triangles || (na.count > 0 && nb.count > 0)) {
       out.push_back({a, b});
