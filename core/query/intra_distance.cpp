@@ -21,6 +21,8 @@ namespace {
 constexpr double kUpperBoundWidening = 1e-12;
 // Triangles per work item of the parallel loops (counters are summed per item).
 constexpr std::size_t kBlock = 64;
+// Triangles per unit of work of the search (node pairs of at most this many triangles).
+constexpr std::int32_t kChunk = 256;
 
 /// Distance between triangles f and g of one object, always evaluated with the lower id first,
 /// so that f's and g's searches get bitwise the same numbers. Expressed from f's side.
@@ -81,31 +83,19 @@ void finish_object(IntraObjectDistance& out) {
   }
 }
 
-/// The per-triangle records of one object while its triangles' searches run in parallel, and
-/// what lets each pair be evaluated once instead of once from each side. Every evaluated pair
-/// is offered to both triangles' records (under a lock per record), and a triangle's search
-/// marks it done when it ends; its record then holds its final answer (every pair within its
-/// bound was evaluated, by it or offered by the other side). f's search skips a candidate g
-/// whose search is done when g's search cannot have skipped f: f's box lies within g's final
-/// bound (<= every bound g's search used) and neither f's D_l nor the pair's separation bound
-/// (the same number from both sides) exceeds it, so g evaluated the pair and offered it to f.
-/// Offers are kept by the smallest (distance, id) as from f's own evaluation (evaluate()
-/// gives both sides bitwise the same numbers), so the records end the same whichever thread
-/// evaluates which pair.
+/// The per-triangle records of one object while the units of its search run in parallel:
+/// each evaluated pair is offered to both triangles' records (under a lock per record), which
+/// keep the smallest (distance, id) as from their own side (evaluate() gives both sides bitwise
+/// the same numbers), so the records end the same whichever thread evaluates which pair.
 class SharedPairs {
  public:
-  explicit SharedPairs(size_t n) : current_(n), done_(n), locks_(n) {
+  explicit SharedPairs(size_t n) : current_(n), locks_(n) {
     for (auto& c : current_) c.store(kInfinity, std::memory_order_relaxed);
-    for (auto& d : done_) d.store(false, std::memory_order_relaxed);
     for (auto& l : locks_) l.store(false, std::memory_order_relaxed);
   }
 
   /// t's best distance so far (never below its final answer).
   double current(size_t t) const { return current_[t].load(std::memory_order_relaxed); }
-
-  /// Whether t's search has ended (then current(t) is its final answer).
-  bool done(size_t t) const { return done_[t].load(std::memory_order_acquire); }
-  void finish(size_t t) { done_[t].store(true, std::memory_order_release); }
 
   /// Offers t (record `best`) the pair (t, other), r being its evaluation from t's side.
   void offer(IntraTriangleNearest& best, size_t t, Index other, const TriangleDistanceResult& r) {
@@ -124,7 +114,6 @@ class SharedPairs {
     std::atomic<bool>& flag;
   };
   std::vector<std::atomic<double>> current_;
-  std::vector<std::atomic<bool>> done_;
   std::vector<std::atomic<bool>> locks_;
 };
 
@@ -191,86 +180,124 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     out.per_object[i].object = static_cast<Index>(i);
     if (!marked(opts.skip, i)) out.per_object[i].per_triangle.assign(static_cast<size_t>(frame.objects[i].num_triangles()), {});
   }
-  // Objects of fewer than 2 triangles have no pairs: no blocks.
-  const ObjectBlocks blocks(n_obj, [&](size_t i) {
-    const size_t n = out.per_object[i].per_triangle.size();
-    return n < 2 ? 0 : ObjectBlocks::blocks_of(n);
-  });
-  std::vector<std::unique_ptr<SharedPairs>> shared(n_obj);
-  std::vector<std::vector<std::array<Index, 3>>> common(n_obj);
+  // Per object of at least 2 triangles, what its search reads: the records, the common
+  // vertices of each node's triangles, and per node the largest reach of its triangles (D_u
+  // plus the rounding slack) and, with Stage II, their smallest D_l.
+  struct ObjectSearch {
+    std::unique_ptr<SharedPairs> pairs;
+    std::vector<std::array<Index, 3>> common;
+    std::vector<double> reach, node_lower;
+    double slack = 0;
+  };
+  std::vector<ObjectSearch> search(n_obj);
+  const SelfVoronoiBounds* voronoi = opts.voronoi;
+  // D_u(t): the 2-ring bound, or Stage II's (which already includes it) when smaller.
+  auto upper_of = [&](size_t i, size_t t) {
+    return voronoi ? std::min(ring2_bound[i][t], voronoi->triangle_upper[i][t]) : ring2_bound[i][t];
+  };
+  // Units of work: per object, the node pairs of at most kChunk triangles that the descent
+  // below goes through first (TriangleBvh::self_pairs_below()).
+  struct Task {
+    size_t object;
+    TriangleBvh::NodePair pair;
+  };
+  std::vector<std::vector<TriangleBvh::NodePair>> units(n_obj);
+  // Whether the descent enters the node pair (a, b) of object i: not when every pair of their
+  // triangles shares a vertex (a vertex common to both nodes' triangles), else when a triangle
+  // of one side may need a triangle of the other: the nodes' boxes within the first side's
+  // reach, and (Stage II) the second side's smallest D_l too.
+  auto enter = [&](size_t i, std::int32_t a, std::int32_t b) {
+    const ObjectSearch& s = search[i];
+    const auto& ca = s.common[static_cast<size_t>(a)];
+    if (a == b) return ca[0] == kNoIndex;
+    if (TriangleBvh::adjacent_subtree(ca, s.common[static_cast<size_t>(b)])) return false;
+    const TriangleBvh& bvh = boxes.bvh(i);
+    const double d2 = box_distance_squared(bvh.node_box(a), bvh.node_box(b));
+    const double ra = s.reach[static_cast<size_t>(a)], rb = s.reach[static_cast<size_t>(b)];
+    const bool lower = !s.node_lower.empty();
+    return (d2 <= ra * ra && (!lower || s.node_lower[static_cast<size_t>(b)] <= ra)) ||
+           (d2 <= rb * rb && (!lower || s.node_lower[static_cast<size_t>(a)] <= rb));
+  };
   parallel_for(n_obj, threads, [&](size_t i) {
-    if (blocks.count(i) == 0) return;
-    // Built here, over objects in parallel, rather than by a block's thread.
-    common[i] = boxes.bvh(i).node_common_vertices(frame.objects[i].topology->faces);
-    shared[i] = std::make_unique<SharedPairs>(boxes.triangles[i].size());
-  });
-
-  std::vector<DistanceCounters> counters(blocks.size());
-  std::vector<std::vector<IntersectingPair>> hits(blocks.size());
-  parallel_for(counters.size(), threads, [&](size_t item) {
-    const auto [object, block] = blocks.locate(item);
-    const size_t i = object;  // a plain variable: lambdas below capture it
-    const Object& o = frame.objects[i];
+    const size_t n = out.per_object[i].per_triangle.size();
+    if (n < 2) return;  // no pairs
+    ObjectSearch& s = search[i];
+    const TriangleBvh& bvh = boxes.bvh(i);
     // Every distance compared here is between two triangles of object i: its own magnitude
     // bounds their rounding (an object far away elsewhere in the scene does not matter).
-    const double slack = rounding_slack(boxes.magnitudes[i]);
+    s.slack = rounding_slack(boxes.magnitudes[i]);
+    s.pairs = std::make_unique<SharedPairs>(n);
+    s.common = bvh.node_common_vertices(frame.objects[i].topology->faces);
+    std::vector<double> reach(n);
+    for (size_t t = 0; t < n; ++t) reach[t] = upper_of(i, t) + s.slack;
+    s.reach = bvh.node_max(reach);
+    if (voronoi) s.node_lower = bvh.node_min(voronoi->triangle_lower[i]);
+    units[i] = bvh.self_pairs_below(kChunk, [&](std::int32_t a, std::int32_t b) { return enter(i, a, b); });
+  });
+  std::vector<Task> tasks;
+  for (size_t i = 0; i < n_obj; ++i)
+    for (const auto& pair : units[i]) tasks.push_back({i, pair});
+
+  // Each unordered pair of non-adjacent triangles (f, g) of an entered pair of leaves is a
+  // candidate for f when their boxes lie within f's bound, min(D_u(f), f's best so far) + slack
+  // (and, with Stage II, D_l(g) does too: a pair at distance d within it has
+  // D_l(g) <= SD(g) <= d), and likewise for g. A side's candidate is culled when the pair's
+  // separation bound exceeds its bound; a pair that is still a candidate for either side is
+  // evaluated once and offered to both. So every triangle's nearest pair is evaluated: at
+  // every level its boxes lie within the triangle's bound, which never drops below that
+  // pair's distance.
+  std::vector<DistanceCounters> counters(tasks.size());
+  std::vector<std::vector<IntersectingPair>> hits(tasks.size());
+  parallel_for(tasks.size(), threads, [&](size_t k) {
+    const size_t i = tasks[k].object;
+    const Object& o = frame.objects[i];
+    const ObjectSearch& s = search[i];
+    SharedPairs& pairs = *s.pairs;
     IntraObjectDistance& res = out.per_object[i];
-    const size_t n = res.per_triangle.size();
-    const auto& tboxes = boxes.triangles[i];
-    const TriangleBvh& bvh = boxes.bvh(i);
-    SharedPairs& pairs = *shared[i];
-    const double* upper = opts.voronoi ? opts.voronoi->triangle_upper[i].data() : nullptr;
-    const double* lower = opts.voronoi ? opts.voronoi->triangle_lower[i].data() : nullptr;
-    // D_u(t): the 2-ring bound, or Stage II's (which already includes it) when smaller.
-    auto upper_of = [&](size_t t) { return upper ? std::min(ring2_bound[i][t], upper[t]) : ring2_bound[i][t]; };
-    DistanceCounters& c = counters[item];
-    for (size_t uf = block * kBlock; uf < std::min(n, (block + 1) * kBlock); ++uf) {
-      const Index f = static_cast<Index>(uf);
-      const double u = upper_of(uf);
-      auto bound = [&] { return std::min(u, pairs.current(uf)) + slack; };
-      // Nearest boxes first, so that the bound drops early. A pair at distance d <= bound
-      // has D_l(g) <= SD(g) <= d (f is non-adjacent to g), so the D_l cut loses nothing.
-      // Subtrees all of whose triangles share one of f's vertices hold no candidate.
-      const Face& ff = o.topology->faces[uf];
-      const auto& node_common = common[i];
-      auto adjacent_subtree = [&](std::int32_t node) {
-        return TriangleBvh::adjacent_subtree(node_common[static_cast<size_t>(node)], ff);
-      };
-      bvh.query(tboxes[uf], bound, [&](Index g, double box_d2) {
-        if (g == f || shares_vertex(o, f, g)) return;
-        ++c.intra_candidates;
-        if (lower && lower[g] > bound()) {
+    const double* lower = voronoi ? voronoi->triangle_lower[i].data() : nullptr;
+    DistanceCounters& c = counters[k];
+    const auto bound = [&](size_t t) { return std::min(upper_of(i, t), pairs.current(t)) + s.slack; };
+    boxes.bvh(i).descend_self(tasks[k].pair, [&](std::int32_t a, std::int32_t b) { return enter(i, a, b); },
+                              [&](Index t, Index u, const AABB& bt, const AABB& bu) {
+      const Index f = std::min(t, u), g = std::max(t, u);
+      const size_t uf = static_cast<size_t>(f), ug = static_cast<size_t>(g);
+      const double d2 = box_distance_squared(bt, bu);
+      const double bf = bound(uf), bg = bound(ug);
+      bool for_f = d2 <= bf * bf, for_g = d2 <= bg * bg;
+      if ((!for_f && !for_g) || shares_vertex(o, f, g)) return;
+      c.intra_candidates += std::uint64_t{for_f} + std::uint64_t{for_g};
+      if (lower) {
+        if (for_f && lower[ug] > bf) {
+          for_f = false;
           ++c.intra_voronoi_culled;
-          return;
         }
-        // Boxes within the bound, triangles provably farther apart (separation_bound.hpp).
-        const double separation = separation_lower_bound(o.triangle(f), o.triangle(g));
-        if (separation > bound()) {
-          ++c.intra_separation_culled;
-          return;
+        if (for_g && lower[uf] > bg) {
+          for_g = false;
+          ++c.intra_voronoi_culled;
         }
-        // g's finished search already evaluated this pair and offered it to f when f's box
-        // lay within g's final bound (its last and smallest) and neither f's D_l nor the
-        // separation bound culled it there (see SharedPairs).
-        const size_t ug = static_cast<size_t>(g);
-        if (pairs.done(ug)) {
-          const double bg = std::min(upper_of(ug), pairs.current(ug)) + slack;
-          if (box_d2 <= bg * bg && separation <= bg && (!lower || lower[uf] <= bg)) {
-            ++c.intra_reused;
-            return;
-          }
-        }
-        ++c.intra_exact_tests;
-        const TriangleDistanceResult r = evaluate(o, f, g);
-        if (r.kind == TriangleDistanceCase::Intersecting) {
-          const Index io = static_cast<Index>(i);
-          hits[item].push_back({io, std::min(f, g), io, std::max(f, g)});
-        }
-        pairs.offer(res.per_triangle[uf], uf, g, r);
-        pairs.offer(res.per_triangle[ug], ug, f, swapped(r));
-      }, adjacent_subtree);
-      pairs.finish(uf);
-    }
+        if (!for_f && !for_g) return;
+      }
+      // Boxes within the bound, triangles provably farther apart (separation_bound.hpp).
+      const double separation = separation_lower_bound(o.triangle(f), o.triangle(g));
+      if (for_f && separation > bf) {
+        for_f = false;
+        ++c.intra_separation_culled;
+      }
+      if (for_g && separation > bg) {
+        for_g = false;
+        ++c.intra_separation_culled;
+      }
+      if (!for_f && !for_g) return;
+      ++c.intra_exact_tests;
+      if (for_f && for_g) ++c.intra_reused;  // one evaluation serves both sides
+      const TriangleDistanceResult r = evaluate(o, f, g);
+      if (r.kind == TriangleDistanceCase::Intersecting) {
+        const Index io = static_cast<Index>(i);
+        hits[k].push_back({io, f, io, g});
+      }
+      pairs.offer(res.per_triangle[uf], uf, g, r);
+      pairs.offer(res.per_triangle[ug], ug, f, swapped(r));
+    });
   });
   for (const auto& c : counters) {
     out.counters.intra_candidates += c.intra_candidates;
@@ -280,7 +307,6 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     out.counters.intra_exact_tests += c.intra_exact_tests;
   }
   for (const auto& h : hits) out.intersecting.insert(out.intersecting.end(), h.begin(), h.end());
-  // Both sides may evaluate a pair (a side skips it only when the other's search has ended).
   std::sort(out.intersecting.begin(), out.intersecting.end());
   out.intersecting.erase(std::unique(out.intersecting.begin(), out.intersecting.end()), out.intersecting.end());
   parallel_for(n_obj, threads, [&](size_t i) { finish_object(out.per_object[i]); });

@@ -51,15 +51,19 @@ struct IntraDistanceOutput {
   std::vector<IntersectingPair> intersecting;
 };
 
-/// Stage III of the intra-object query. For each triangle f, a BVH range query around f's box
-/// with the current bound min(2-ring bound, D_u(f), best so far) (+ rounding slack); triangles
-/// sharing a vertex with f are skipped, with Stage II a triangle g is skipped when D_l(g)
-/// exceeds the bound, and the exact test runs on what is left.
+/// Stage III of the intra-object query. Per object, its BVH is descended against itself
+/// (TriangleBvh::descend_self()), entering a pair of subtrees when a triangle of one may need a
+/// triangle of the other: their boxes within the first one's largest bound (D_u + rounding
+/// slack, D_u the 2-ring bound or Stage II's when smaller) and, with Stage II, the other's
+/// smallest D_l within it too; and not when a vertex is common to all their triangles. Each
+/// unordered pair of non-adjacent triangles of two entered leaves is a candidate for f when
+/// their boxes lie within f's bound min(D_u(f), f's best so far) + slack and D_l(g) does too
+/// (likewise for g); a side whose bound the pair's separation bound exceeds drops it, and a
+/// pair still wanted by either side is evaluated once and offered to both (SharedPairs).
 ///
 /// Every non-adjacent pair that intersects (distance 0) is evaluated: its boxes overlap, its
-/// separation bound is at most 0 and both D_l are at most 0, so neither side's bound culls it,
-/// and one side skips it only when the other evaluated it (SharedPairs; both sides may
-/// evaluate it). Those evaluated as intersecting are listed in `intersecting`, once each.
+/// separation bound is at most 0 and both D_l are at most 0, so no bound culls it. Those
+/// evaluated as intersecting are listed in `intersecting`, once each.
 ///
 /// Deterministic and thread-count independent: every unordered pair {f, g} is evaluated as
 /// triangle_distance(triangle min(f, g), triangle max(f, g)) (points swapped for the other

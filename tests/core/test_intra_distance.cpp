@@ -94,17 +94,16 @@ TEST(IntraDistance, EqualsBruteForceOnAllScenesAndThreadCounts) {
       separated += got.counters.intra_separation_culled;
     }
   }
-  // Pairs evaluated from one side are offered to the other, which then skips them; pairs
-  // whose boxes are within the bound but whose triangles are not are skipped untested.
+  // Pairs wanted by both triangles are evaluated once for both; pairs whose boxes are within
+  // the bound but whose triangles are not are skipped untested.
   EXPECT_GT(reused, 0u);
   EXPECT_GT(separated, 0u);
   // The soups and jittered blobs intersect themselves, or the pair lists prove little.
   EXPECT_GT(intersecting, 100u);
 }
 
-// Large soups, searched by 3 threads in blocks of 64 triangles: a pair is then also met from
-// its higher id's side (whose block ran first) and sometimes from both sides; each intersecting
-// pair is listed once either way.
+// Large soups, searched by 3 threads in units of at most 256 triangles (node pairs of the
+// descent): each intersecting pair is listed once, whichever unit met it.
 TEST(IntraDistance, IntersectingPairsOfLargeObjectsOnManyThreadsAreListedOnce) {
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
     Rng rng(seed);
@@ -363,6 +362,39 @@ void for_each_recorded_run(const Check& check) {
 // The default self grid: sqrt(n) cells for one surface spanning the scene, but no cell below
 // 0.7 of the median triangle, so a crowd of small objects is not sampled at cells far below its
 // triangles (27.7 samples per triangle for 2,000 blobs before); clamped to [32, 512].
+// Stage III with the tightest bounds Stage II may give, D_l(g) = D_u(g) = SD(g) (from the brute
+// force), or D_l(g) anywhere in [SD(g) / 4, SD(g)] with D_u left to the 2-ring bound: the
+// search drops many candidates by D_l, here and through a node's smallest D_l, and must still
+// meet every triangle's nearest pair.
+TEST(IntraStage2, TightBoundsStillGiveTheBruteForce) {
+  std::uint64_t culled = 0;
+  for (const auto& [name, frame] : scenes()) {
+    const auto ref = intra_object_distance_brute_force(frame);
+    const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
+    const auto ring2 = ring2_upper_bounds(frame, 2);
+    for (const bool exact : {true, false}) {
+      SCOPED_TRACE(name + (exact ? ", D_l = D_u = SD" : ", D_l in [SD / 4, SD]"));
+      Rng rng(17);
+      SelfVoronoiBounds vb;
+      vb.triangle_upper.resize(frame.objects.size());
+      vb.triangle_lower.resize(frame.objects.size());
+      for (size_t i = 0; i < frame.objects.size(); ++i)
+        for (size_t t = 0; t < ref.per_object[i].per_triangle.size(); ++t) {
+          const double sd = ref.per_object[i].per_triangle[t].distance;  // infinite: no pair
+          vb.triangle_upper[i].push_back(exact ? sd : kInfinity);
+          vb.triangle_lower[i].push_back(exact || !std::isfinite(sd) ? sd : sd * rng.uniform(0.25, 1.0));
+        }
+      for (int threads : {1, 3}) {
+        const auto got = intra_object_distance(frame, boxes, ring2, IntraDistanceOptions{threads, &vb});
+        expect_same_intra(got, ref, "threads " + std::to_string(threads));
+        expect_candidates_accounted(got.counters, name);
+        culled += got.counters.intra_voronoi_culled;
+      }
+    }
+  }
+  EXPECT_GT(culled, 0u);
+}
+
 TEST(IntraStage2, DefaultGridFollowsTheMedianTriangleInCrowds) {
   EXPECT_EQ(default_self_grid_resolution(18484, 2.65, 0.0195), 136);  // sqrt(n) when the triangles allow it
   EXPECT_EQ(default_self_grid_resolution(360000, 37.4, 0.2), 267);    // 37.4 / (0.7 * 0.2), below sqrt(n) = 600
