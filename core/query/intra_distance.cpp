@@ -23,6 +23,8 @@ constexpr double kUpperBoundWidening = 1e-12;
 constexpr std::size_t kBlock = 64;
 // Triangles per unit of work of the search (node pairs of at most this many triangles).
 constexpr std::int32_t kChunk = 256;
+// Ranges of squared box distance in which a unit of work orders its pairs (see below).
+constexpr std::size_t kLaterRanges = 8;
 
 /// Distance between triangles f and g of one object, always evaluated with the lower id first,
 /// so that f's and g's searches get bitwise the same numbers. Expressed from f's side.
@@ -180,21 +182,18 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     out.per_object[i].object = static_cast<Index>(i);
     if (!marked(opts.skip, i)) out.per_object[i].per_triangle.assign(static_cast<size_t>(frame.objects[i].num_triangles()), {});
   }
-  // Per object of at least 2 triangles, what its search reads: the records, the common
-  // vertices of each node's triangles, and per node the largest reach of its triangles (D_u
-  // plus the rounding slack) and, with Stage II, their smallest D_l.
+  // Per object of at least 2 triangles, what its search reads: the records, each triangle's
+  // D_u, the common vertices of each node's triangles, and per node the largest reach of its
+  // triangles (D_u plus the rounding slack) and, with Stage II, their smallest D_l.
   struct ObjectSearch {
     std::unique_ptr<SharedPairs> pairs;
+    std::vector<double> upper;
     std::vector<std::array<Index, 3>> common;
     std::vector<double> reach, node_lower;
     double slack = 0;
   };
   std::vector<ObjectSearch> search(n_obj);
   const SelfVoronoiBounds* voronoi = opts.voronoi;
-  // D_u(t): the 2-ring bound, or Stage II's (which already includes it) when smaller.
-  auto upper_of = [&](size_t i, size_t t) {
-    return voronoi ? std::min(ring2_bound[i][t], voronoi->triangle_upper[i][t]) : ring2_bound[i][t];
-  };
   // Units of work: per object, the node pairs of at most kChunk triangles that the descent
   // below goes through first (TriangleBvh::self_pairs_below()).
   struct Task {
@@ -228,8 +227,12 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     s.slack = rounding_slack(boxes.magnitudes[i]);
     s.pairs = std::make_unique<SharedPairs>(n);
     s.common = bvh.node_common_vertices(frame.objects[i].topology->faces);
+    // D_u(t): the 2-ring bound, or Stage II's (which already includes it) when smaller.
+    s.upper = ring2_bound[i];
+    if (voronoi)
+      for (size_t t = 0; t < n; ++t) s.upper[t] = std::min(s.upper[t], voronoi->triangle_upper[i][t]);
     std::vector<double> reach(n);
-    for (size_t t = 0; t < n; ++t) reach[t] = upper_of(i, t) + s.slack;
+    for (size_t t = 0; t < n; ++t) reach[t] = s.upper[t] + s.slack;
     s.reach = bvh.node_max(reach);
     if (voronoi) s.node_lower = bvh.node_min(voronoi->triangle_lower[i]);
     units[i] = bvh.self_pairs_below(kChunk, [&](std::int32_t a, std::int32_t b) { return enter(i, a, b); });
@@ -256,15 +259,14 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     IntraObjectDistance& res = out.per_object[i];
     const double* lower = voronoi ? voronoi->triangle_lower[i].data() : nullptr;
     DistanceCounters& c = counters[k];
-    const auto bound = [&](size_t t) { return std::min(upper_of(i, t), pairs.current(t)) + s.slack; };
-    boxes.bvh(i).descend_self(tasks[k].pair, [&](std::int32_t a, std::int32_t b) { return enter(i, a, b); },
-                              [&](Index t, Index u, const AABB& bt, const AABB& bu) {
-      const Index f = std::min(t, u), g = std::max(t, u);
+    const double* upper = s.upper.data();
+    const auto bound = [&](size_t t) { return std::min(upper[t], pairs.current(t)) + s.slack; };
+    // The candidate pair (f, g), f < g, whose boxes are d2 apart (squared).
+    auto consider = [&](Index f, Index g, double d2) {
       const size_t uf = static_cast<size_t>(f), ug = static_cast<size_t>(g);
-      const double d2 = box_distance_squared(bt, bu);
       const double bf = bound(uf), bg = bound(ug);
       bool for_f = d2 <= bf * bf, for_g = d2 <= bg * bg;
-      if ((!for_f && !for_g) || shares_vertex(o, f, g)) return;
+      if (!for_f && !for_g) return;
       c.intra_candidates += std::uint64_t{for_f} + std::uint64_t{for_g};
       if (lower) {
         if (for_f && lower[ug] > bf) {
@@ -297,7 +299,42 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
       }
       pairs.offer(res.per_triangle[uf], uf, g, r);
       pairs.offer(res.per_triangle[ug], ug, f, swapped(r));
+    };
+    // Pairs whose boxes overlap are considered as the descent meets them, the others after it,
+    // nearer boxes first (by a counting sort into kLaterRanges equal ranges of squared box
+    // distance): so a triangle's bound comes down on its near pairs before its far ones are
+    // tried, as in a search per triangle nearest first. In the descent's order alone, skirt
+    // and cloth-ball ran 45% and 56% more exact tests than that search.
+    struct Later {
+      double d2;
+      Index f, g;
+    };
+    thread_local std::vector<Later> later, sorted;
+    thread_local std::vector<std::uint32_t> first;
+    later.clear();
+    double farthest = 0;
+    boxes.bvh(i).descend_self(tasks[k].pair, [&](std::int32_t a, std::int32_t b) { return enter(i, a, b); },
+                              [&](Index t, Index u, const AABB& bt, const AABB& bu) {
+      const Index f = std::min(t, u), g = std::max(t, u);
+      const double d2 = box_distance_squared(bt, bu);
+      const double bf = bound(static_cast<size_t>(f)), bg = bound(static_cast<size_t>(g));
+      if ((d2 > bf * bf && d2 > bg * bg) || shares_vertex(o, f, g)) return;
+      if (d2 > 0) {
+        later.push_back({d2, f, g});
+        farthest = std::max(farthest, d2);
+      } else {
+        consider(f, g, d2);
+      }
     });
+    // Clamped in double: with a subnormal `farthest` the scale may be infinite.
+    const double scale = kLaterRanges / farthest, last = kLaterRanges - 1;
+    auto range_of = [&](double d2) { return static_cast<std::size_t>(std::min(last, d2 * scale)); };
+    first.assign(kLaterRanges + 1, 0);
+    for (const Later& l : later) ++first[range_of(l.d2) + 1];
+    for (std::size_t r = 0; r < kLaterRanges; ++r) first[r + 1] += first[r];
+    sorted.resize(later.size());
+    for (const Later& l : later) sorted[first[range_of(l.d2)]++] = l;
+    for (const Later& l : sorted) consider(l.f, l.g, l.d2);
   });
   for (const auto& c : counters) {
     out.counters.intra_candidates += c.intra_candidates;
