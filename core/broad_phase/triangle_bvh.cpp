@@ -70,32 +70,36 @@ void TriangleBvh::build(const std::vector<AABB>& boxes, int threads) {
   }
 }
 
-std::vector<double> TriangleBvh::node_min(const std::vector<double>& value) const {
-  std::vector<double> out(nodes_.size(), std::numeric_limits<double>::infinity());
-  for (size_t n = nodes_.size(); n-- > 0;) {  // children first, as above
-    const Node& node = nodes_[n];
+namespace {
+
+/// Per node of `nodes` (children after their parent), value[t] over the triangles t of its
+/// subtree (order: the triangles of the leaves' ranges) folded with `pick` from `init`.
+template <typename Node, typename Pick>
+std::vector<double> fold_nodes(const std::vector<Node>& nodes, const std::vector<Index>& order,
+                               const std::vector<double>& value, double init, const Pick& pick) {
+  std::vector<double> out(nodes.size(), init);
+  for (size_t n = nodes.size(); n-- > 0;) {  // children first
+    const Node& node = nodes[n];
     if (node.count > 0) {
       for (std::int32_t k = node.first; k < node.first + node.count; ++k)
-        out[n] = std::min(out[n], value[static_cast<size_t>(order_[static_cast<size_t>(k)])]);
+        out[n] = pick(out[n], value[static_cast<size_t>(order[static_cast<size_t>(k)])]);
     } else {
-      out[n] = std::min(out[static_cast<size_t>(node.first)], out[static_cast<size_t>(node.first) + 1]);
+      out[n] = pick(out[static_cast<size_t>(node.first)], out[static_cast<size_t>(node.first) + 1]);
     }
   }
   return out;
 }
 
+}  // namespace
+
+std::vector<double> TriangleBvh::node_min(const std::vector<double>& value) const {
+  return fold_nodes(nodes_, order_, value, std::numeric_limits<double>::infinity(),
+                    [](double x, double y) { return std::min(x, y); });
+}
+
 std::vector<double> TriangleBvh::node_max(const std::vector<double>& value) const {
-  std::vector<double> out(nodes_.size(), -std::numeric_limits<double>::infinity());
-  for (size_t n = nodes_.size(); n-- > 0;) {  // children first, as above
-    const Node& node = nodes_[n];
-    if (node.count > 0) {
-      for (std::int32_t k = node.first; k < node.first + node.count; ++k)
-        out[n] = std::max(out[n], value[static_cast<size_t>(order_[static_cast<size_t>(k)])]);
-    } else {
-      out[n] = std::max(out[static_cast<size_t>(node.first)], out[static_cast<size_t>(node.first) + 1]);
-    }
-  }
-  return out;
+  return fold_nodes(nodes_, order_, value, -std::numeric_limits<double>::infinity(),
+                    [](double x, double y) { return std::max(x, y); });
 }
 
 std::vector<AABB> TriangleBvh::node_unions(const std::vector<AABB>& boxes) const {
