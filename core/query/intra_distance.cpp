@@ -19,7 +19,7 @@ namespace {
 // Vertex pair distances are a few roundings away from exact; widening them by 1e-12 relative
 // keeps the 2-ring bound an upper bound of the exact distance (as Stage I does for U_i).
 constexpr double kUpperBoundWidening = 1e-12;
-// Triangles per work item of the parallel loops (counters are summed per item).
+// Triangles per work item of the 2-ring bounds' parallel loop.
 constexpr std::size_t kBlock = 64;
 // Triangles per unit of work of the search (node pairs of at most this many triangles).
 constexpr std::int32_t kChunk = 256;
@@ -262,7 +262,7 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     const double* upper = s.upper.data();
     const auto bound = [&](size_t t) { return std::min(upper[t], pairs.current(t)) + s.slack; };
     // The candidate pair (f, g), f < g, whose boxes are d2 apart (squared).
-    auto consider = [&](Index f, Index g, double d2) {
+    auto try_pair = [&](Index f, Index g, double d2) {
       const size_t uf = static_cast<size_t>(f), ug = static_cast<size_t>(g);
       const double bf = bound(uf), bg = bound(ug);
       bool for_f = d2 <= bf * bf, for_g = d2 <= bg * bg;
@@ -323,7 +323,7 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
         later.push_back({d2, f, g});
         farthest = std::max(farthest, d2);
       } else {
-        consider(f, g, d2);
+        try_pair(f, g, d2);
       }
     });
     // Clamped in double: with a subnormal `farthest` the scale may be infinite.
@@ -334,7 +334,7 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     for (std::size_t r = 0; r < kLaterRanges; ++r) first[r + 1] += first[r];
     sorted.resize(later.size());
     for (const Later& l : later) sorted[first[range_of(l.d2)]++] = l;
-    for (const Later& l : sorted) consider(l.f, l.g, l.d2);
+    for (const Later& l : sorted) try_pair(l.f, l.g, l.d2);
   });
   for (const auto& c : counters) {
     out.counters.intra_candidates += c.intra_candidates;

@@ -60,6 +60,8 @@ struct IntraDistanceOutput {
 /// their boxes lie within f's bound min(D_u(f), f's best so far) + slack and D_l(g) does too
 /// (likewise for g); a side whose bound the pair's separation bound exceeds drops it, and a
 /// pair still wanted by either side is evaluated once and offered to both (SharedPairs).
+/// Within a unit of work (a node pair of at most 256 triangles), pairs whose boxes overlap are
+/// tried as the descent meets them and the others after it, nearer boxes first.
 ///
 /// Every non-adjacent pair that intersects (distance 0) is evaluated: its boxes overlap, its
 /// separation bound is at most 0 and both D_l are at most 0, so no bound culls it. Those
