@@ -11,6 +11,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <memory>
 #include <set>
@@ -226,6 +227,23 @@ bool primitives_apart(const SweptPrimitives<NA, NB>& p, std::initializer_list<Ve
     if (points_apart_along(p.a_start, p.a_end, p.b_start, p.b_end, Vec3::Unit(k), gap)) return true;
   for (const Vec3& w : axes)
     if (points_apart_along(p.a_start, p.a_end, p.b_start, p.b_end, w, gap)) return true;
+  return false;
+}
+
+/// primitives_apart()'s test along the given axes only, built when needed: `axis(k)` for k in
+/// [0, n). The in-plane axes below come after the others: they cost a cross product each, and
+/// as products of three coordinate differences they are scaled by a power of two to a largest
+/// component in [1, 2) (exact, so a scene scaled by a power of two is culled alike; unscaled,
+/// the squared gaps of a scene at 2^-150 underflowed).
+template <std::size_t NA, std::size_t NB, typename Axis>
+bool apart_along_any(const SweptPrimitives<NA, NB>& p, int n, const Axis& axis, double gap) {
+  for (int k = 0; k < n; ++k) {
+    Vec3 w = axis(k);
+    const double m = w.cwiseAbs().maxCoeff();
+    if (!(m > 0) || !std::isfinite(m)) continue;
+    w *= std::ldexp(1.0, -std::ilogb(m));
+    if (points_apart_along(p.a_start, p.a_end, p.b_start, p.b_end, w, gap)) return true;
+  }
   return false;
 }
 
@@ -839,7 +857,15 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
       const SweptPrimitives<1, 3> p{{from.objects[static_cast<size_t>(ov)].positions[static_cast<size_t>(v)]},
                                     {to.objects[static_cast<size_t>(ov)].positions[static_cast<size_t>(v)]},
                                     g_swept.start, g_swept.end};
-      return primitives_apart(p, {g_swept.normal, g_swept.normal_end}, 2 * margin) ? Cull::apart : Cull::test;
+      if (primitives_apart(p, {g_swept.normal, g_swept.normal_end}, 2 * margin)) return Cull::apart;
+      // A vertex beside the face in (or near) its plane, as in a flat mesh around a shared
+      // vertex or edge, is apart along none of those: the face's in-plane edge normals at the
+      // start (normal x edge) separate it when it stays outside one edge.
+      const auto& t = g_swept.start;
+      const bool beside = apart_along_any(p, 3, [&](int e) {
+        return g_swept.normal.cross(t[static_cast<size_t>((e + 1) % 3)] - t[static_cast<size_t>(e)]);
+      }, 2 * margin);
+      return beside ? Cull::apart : Cull::test;
     };
 
     // The primitive pairs of a candidate triangle pair that the culling leaves, as a mask:
@@ -886,8 +912,15 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
           const SweptPrimitives<2, 2> p{ends(oi, va), ends(ti, va), ends(oj, vb), ends(tj, vb)};
           const Vec3 cross_start = (p.a_start[1] - p.a_start[0]).cross(p.b_start[1] - p.b_start[0]);
           const Vec3 cross_end = (p.a_end[1] - p.a_end[0]).cross(p.b_end[1] - p.b_end[0]);
-          note(primitives_apart(p, {cross_start, cross_end}, 2 * margin) ? Cull::apart : Cull::test,
-               static_cast<int>(6 + 3 * ka + kb));
+          // Then, for two edges side by side in a plane (where cross_start is its normal), each
+          // edge's in-plane normal at the start (edge x cross_start).
+          const bool apart =
+              primitives_apart(p, {cross_start, cross_end}, 2 * margin) ||
+              apart_along_any(p, 2, [&](int e) {
+                const auto& ends = e == 0 ? p.a_start : p.b_start;
+                return (ends[1] - ends[0]).cross(cross_start);
+              }, 2 * margin);
+          note(apart ? Cull::apart : Cull::test, static_cast<int>(6 + 3 * ka + kb));
         }
       }
       return mask;
