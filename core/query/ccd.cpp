@@ -917,8 +917,8 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
           const bool apart =
               primitives_apart(p, {cross_start, cross_end}, 2 * margin) ||
               apart_along_any(p, 2, [&](int e) {
-                const auto& ends = e == 0 ? p.a_start : p.b_start;
-                return (ends[1] - ends[0]).cross(cross_start);
+                const auto& edge = e == 0 ? p.a_start : p.b_start;
+                return (edge[1] - edge[0]).cross(cross_start);
               }, 2 * margin);
           note(apart ? Cull::apart : Cull::test, static_cast<int>(6 + 3 * ka + kb));
         }
