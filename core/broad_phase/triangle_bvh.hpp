@@ -160,6 +160,11 @@ class TriangleBvh {
                     : boxes_overlap(nodes_[static_cast<size_t>(x)].box, nodes_[static_cast<size_t>(y)].box) && !skip(x, y);
     };
   }
+  /// The descent shared by descend_self() and self_pairs_below(): from `start` (on `stack`,
+  /// cleared first), passes over a pair unless enter(a, b), and splits it (push_self_split())
+  /// unless done(a, b, node a, node b) has taken it whole.
+  template <typename Enter, typename Done>
+  void walk_self(const NodePair& start, std::vector<NodePair>& stack, const Enter& enter, const Done& done) const;
   /// Pushes the node pairs that self_overlaps() splits the pair (a, b) into (not two leaves
   /// nor one leaf with itself), in the order it takes them (the last pushed first).
   void push_self_split(const NodePair& pair, std::vector<NodePair>& stack) const {
@@ -250,27 +255,31 @@ void TriangleBvh::self_overlaps(const NodePair& start, const Skip& skip, const V
   });
 }
 
-template <typename Enter, typename Visit>
-void TriangleBvh::descend_self(const NodePair& start, const Enter& enter, const Visit& visit) const {
-  if (nodes_.empty()) return;
-  thread_local std::vector<NodePair> stack;  // reused: called per unit of work
+template <typename Enter, typename Done>
+void TriangleBvh::walk_self(const NodePair& start, std::vector<NodePair>& stack, const Enter& enter,
+                            const Done& done) const {
   stack.clear();
   stack.push_back(start);
   while (!stack.empty()) {
     const auto [a, b] = stack.back();
     stack.pop_back();
     if (!enter(a, b)) continue;
-    const Node& na = nodes_[static_cast<size_t>(a)];
-    const Node& nb = nodes_[static_cast<size_t>(b)];
-    if (na.count > 0 && (a == b || nb.count > 0)) {
-      for (std::int32_t k = na.first; k < na.first + na.count; ++k)
-        for (std::int32_t m = a == b ? k + 1 : nb.first; m < nb.first + nb.count; ++m)
-          visit(order_[static_cast<size_t>(k)], order_[static_cast<size_t>(m)], leaf_boxes_[static_cast<size_t>(k)],
-                leaf_boxes_[static_cast<size_t>(m)]);
-      continue;
-    }
-    push_self_split({a, b}, stack);
+    if (!done(a, b, nodes_[static_cast<size_t>(a)], nodes_[static_cast<size_t>(b)])) push_self_split({a, b}, stack);
   }
+}
+
+template <typename Enter, typename Visit>
+void TriangleBvh::descend_self(const NodePair& start, const Enter& enter, const Visit& visit) const {
+  if (nodes_.empty()) return;
+  thread_local std::vector<NodePair> stack;  // reused: called per unit of work
+  walk_self(start, stack, enter, [&](std::int32_t a, std::int32_t b, const Node& na, const Node& nb) {
+    if (na.count == 0 || (a != b && nb.count == 0)) return false;  // not two leaves: split
+    for (std::int32_t k = na.first; k < na.first + na.count; ++k)
+      for (std::int32_t m = a == b ? k + 1 : nb.first; m < nb.first + nb.count; ++m)
+        visit(order_[static_cast<size_t>(k)], order_[static_cast<size_t>(m)], leaf_boxes_[static_cast<size_t>(k)],
+              leaf_boxes_[static_cast<size_t>(m)]);
+    return true;
+  });
 }
 
 template <typename Enter>
@@ -284,20 +293,13 @@ std::vector<TriangleBvh::NodePair> TriangleBvh::self_pairs_below(std::int32_t ma
     count[n] = node.count > 0 ? node.count : count[static_cast<size_t>(node.first)] + count[static_cast<size_t>(node.first) + 1];
   }
   // The same expansion as descend_self(), in the same order, stopping at small pairs.
-  std::vector<NodePair> stack{{0, 0}};
-  while (!stack.empty()) {
-    const auto [a, b] = stack.back();
-    stack.pop_back();
-    if (!enter(a, b)) continue;
-    const Node& na = nodes_[static_cast<size_t>(a)];
-    const Node& nb = nodes_[static_cast<size_t>(b)];
+  std::vector<NodePair> stack;
+  walk_self({0, 0}, stack, enter, [&](std::int32_t a, std::int32_t b, const Node& na, const Node& nb) {
     const std::int32_t held = a == b ? count[static_cast<size_t>(a)] : count[static_cast<size_t>(a)] + count[static_cast<size_t>(b)];
-    if (held <= max_triangles || (na.count > 0 && nb.count > 0)) {
-      out.push_back({a, b});
-      continue;
-    }
-    push_self_split({a, b}, stack);
-  }
+    if (held > max_triangles && (na.count == 0 || nb.count == 0)) return false;
+    out.push_back({a, b});
+    return true;
+  });
   return out;
 }
 
