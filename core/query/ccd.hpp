@@ -12,8 +12,10 @@
 // below), sweep-and-prune over the swept object boxes, then per object pair a BVH over the
 // swept triangle boxes gives the candidate triangle pairs; a subtree or a pair that a
 // separating axis shows apart by more than twice the margin at both ends of the step (hence
-// throughout it: ccd.cpp) is skipped, and so is each primitive pair of the remaining triangle
-// pairs that the same argument shows apart (CcdCounters::separated_primitives). Optional Stage II
+// throughout it: ccd.cpp) is skipped (two triangles of one object sharing one vertex: when one
+// axis through that vertex shows all their primitive pairs apart), and so is each primitive
+// pair of the remaining triangle pairs that the same argument shows apart
+// (CcdCounters::separated_primitives). Optional Stage II
 // (core/voronoi/ccd_stage2.hpp) culls the triangle pairs left after the separating-axis tests
 // (of the pairs and of their primitives) with a voxelization of the swept prisms: of those
 // pairs' triangles only, when built here.

@@ -4,6 +4,8 @@
 // objects whose topology changes; the exclusions of incident primitive pairs.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include "core/geometry/ccd.hpp"
 #include "core/query/ccd.hpp"
 #include "core/voronoi/ccd_stage2.hpp"
@@ -490,6 +492,67 @@ TEST(CcdPipeline, NearMissesWithinTheKernelToleranceAreKept) {
     const CcdStepResult ref = continuous_collisions_brute_force(from, to);
     EXPECT_FALSE(ref.vf.empty() && ref.ee.empty()) << "the kernel reports no near miss here";
     for (int threads : {1, 2}) expect_same_ccd(continuous_collisions(from, to, CcdOptions{threads, nullptr}), ref);
+  }
+}
+
+TEST(CcdPipeline, TrianglesAroundASharedVertexAreCulledAsAPairOnlyWhenApart) {
+  // Two triangles of one object that share only the vertex c: f = (c, a, b) and g = (c, d, e).
+  // Flat and apart on either side of a line through c, moving rigidly, the pair is shown apart
+  // as a whole (one axis for all its primitive pairs) and nothing is tested. When g swings
+  // through f (a real collision between them), or when g lies across f's sector from the
+  // start, no axis through c separates them, and the result is the brute force's.
+  const Eigen::Matrix3d turn =
+      (Eigen::AngleAxisd(0.7, Vec3(0, 0, 1)) * Eigen::AngleAxisd(0.4, Vec3(1, 0, 0))).toRotationMatrix();
+  auto at = [&](double x, double y, double z) { return Vec3(turn * Vec3(x, y, z) + Vec3(0.3, -0.2, 0.1)); };
+  auto topo = std::make_shared<Topology>();
+  topo->num_vertices = 5;
+  topo->faces = {{0, 1, 2}, {0, 3, 4}};
+  Object o;
+  o.name = "fan";
+  o.topology = topo;
+  o.positions = {at(0, 0, 0), at(1, 0.1, 0), at(0.8, 0.7, 0), at(-0.9, 0.5, 0), at(-0.8, -0.3, 0)};
+  auto run = [&](const Object& start, const Object& end) {
+    Frame from, to;
+    from.objects = {start};
+    to.objects = {end};
+    to.index = 1;
+    const CcdStepResult ref = continuous_collisions_brute_force(from, to);
+    CcdStepResult got;
+    for (int threads : {1, 2}) {
+      got = continuous_collisions(from, to, CcdOptions{threads, nullptr});
+      expect_same_ccd(got, ref);
+    }
+    return std::pair{got, ref};
+  };
+  {
+    SCOPED_TRACE("apart, moving rigidly");
+    Object next = o;
+    for (Vec3& p : next.positions) p += Vec3(0.01, -0.02, 0.03);
+    const auto [got, ref] = run(o, next);
+    EXPECT_EQ(got.counters.triangle_pairs, 1u);
+    EXPECT_EQ(got.counters.separated_pairs, 1u);
+    EXPECT_EQ(got.counters.separated_primitives, 0u);
+    EXPECT_EQ(got.counters.vf_tests + got.counters.ee_tests, 0u);
+    EXPECT_TRUE(ref.vf.empty() && ref.ee.empty());
+  }
+  {
+    SCOPED_TRACE("g swings through f");
+    Object next = o;
+    next.positions[3] = at(0.9, 0.6, 0.3);
+    next.positions[4] = at(0.9, 0.2, -0.3);
+    const auto [got, ref] = run(o, next);
+    EXPECT_EQ(got.counters.separated_pairs, 0u);
+    EXPECT_FALSE(ref.vf.empty() && ref.ee.empty()) << "no collision to find";
+  }
+  {
+    SCOPED_TRACE("g across f's sector");
+    Object start = o;
+    start.positions[3] = at(0.5, 0.9, 0.2);
+    start.positions[4] = at(0.6, -0.4, 0.2);
+    Object next = start;
+    for (Vec3& p : next.positions) p += Vec3(0.01, -0.02, 0.03);
+    const auto [got, ref] = run(start, next);
+    EXPECT_EQ(got.counters.separated_pairs, 0u);
   }
 }
 
