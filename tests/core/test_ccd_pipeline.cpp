@@ -504,13 +504,8 @@ TEST(CcdPipeline, TrianglesAroundASharedVertexAreCulledAsAPairOnlyWhenApart) {
   const Eigen::Matrix3d turn =
       (Eigen::AngleAxisd(0.7, Vec3(0, 0, 1)) * Eigen::AngleAxisd(0.4, Vec3(1, 0, 0))).toRotationMatrix();
   auto at = [&](double x, double y, double z) { return Vec3(turn * Vec3(x, y, z) + Vec3(0.3, -0.2, 0.1)); };
-  auto topo = std::make_shared<Topology>();
-  topo->num_vertices = 5;
-  topo->faces = {{0, 1, 2}, {0, 3, 4}};
-  Object o;
-  o.name = "fan";
-  o.topology = topo;
-  o.positions = {at(0, 0, 0), at(1, 0.1, 0), at(0.8, 0.7, 0), at(-0.9, 0.5, 0), at(-0.8, -0.3, 0)};
+  const Object o = test::make_object({at(0, 0, 0), at(1, 0.1, 0), at(0.8, 0.7, 0), at(-0.9, 0.5, 0), at(-0.8, -0.3, 0)},
+                                     {{0, 1, 2}, {0, 3, 4}}, "fan");
   auto run = [&](const Object& start, const Object& end) {
     Frame from, to;
     from.objects = {start};
