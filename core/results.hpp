@@ -193,7 +193,8 @@ struct CcdCounters {
   std::uint64_t object_pairs = 0;     ///< object pairs (i <= j) whose swept boxes overlap
   /// Candidate triangle pairs after the box culling (Stage I's BVH walk).
   std::uint64_t triangle_pairs = 0;
-  /// Of those, pairs shown apart for the whole step along a separating axis (no tests ran).
+  /// Of those, pairs shown apart for the whole step along a separating axis (no tests ran); for
+  /// two triangles of one object sharing one vertex, all their primitive pairs along one axis.
   std::uint64_t separated_pairs = 0;
   /// Of the rest, pairs Stage II rules out (no tests ran): inter-object, one of the two
   /// triangles has no (slot, voxel) key that another object marks; or the two share no key.
