@@ -56,68 +56,25 @@ void TriangleBvh::build(const std::vector<AABB>& boxes, int threads) {
   }
   leaf_boxes_.resize(order_.size());
   for (size_t k = 0; k < order_.size(); ++k) leaf_boxes_[k] = boxes[static_cast<size_t>(order_[k])];
-  node_min_ids_.assign(nodes_.size(), std::numeric_limits<Index>::max());
-  // Children come after their parent in nodes_, so a reverse pass sees them first.
-  for (size_t m = nodes_.size(); m-- > 0;) {
-    const Node& node = nodes_[m];
-    Index& least = node_min_ids_[m];
-    if (node.count > 0) {
-      for (std::int32_t k = node.first; k < node.first + node.count; ++k)
-        least = std::min(least, order_[static_cast<size_t>(k)]);
-    } else {
-      least = std::min(node_min_ids_[static_cast<size_t>(node.first)], node_min_ids_[static_cast<size_t>(node.first) + 1]);
-    }
-  }
+  node_min_ids_ = fold_nodes(std::numeric_limits<Index>::max(), [](Index t) { return t; },
+                             [](Index x, Index y) { return std::min(x, y); });
 }
-
-namespace {
-
-/// Per node of `nodes` (children after their parent), value[t] over the triangles t of its
-/// subtree (order: the triangles of the leaves' ranges) folded with `pick` from `init`.
-template <typename Node, typename Pick>
-std::vector<double> fold_nodes(const std::vector<Node>& nodes, const std::vector<Index>& order,
-                               const std::vector<double>& value, double init, const Pick& pick) {
-  std::vector<double> out(nodes.size(), init);
-  for (size_t n = nodes.size(); n-- > 0;) {  // children first
-    const Node& node = nodes[n];
-    if (node.count > 0) {
-      for (std::int32_t k = node.first; k < node.first + node.count; ++k)
-        out[n] = pick(out[n], value[static_cast<size_t>(order[static_cast<size_t>(k)])]);
-    } else {
-      out[n] = pick(out[static_cast<size_t>(node.first)], out[static_cast<size_t>(node.first) + 1]);
-    }
-  }
-  return out;
-}
-
-}  // namespace
 
 std::vector<double> TriangleBvh::node_min(const std::vector<double>& value) const {
-  return fold_nodes(nodes_, order_, value, std::numeric_limits<double>::infinity(),
+  return fold_nodes(std::numeric_limits<double>::infinity(), [&](Index t) { return value[static_cast<size_t>(t)]; },
                     [](double x, double y) { return std::min(x, y); });
 }
 
 std::vector<double> TriangleBvh::node_max(const std::vector<double>& value) const {
-  return fold_nodes(nodes_, order_, value, -std::numeric_limits<double>::infinity(),
+  return fold_nodes(-std::numeric_limits<double>::infinity(), [&](Index t) { return value[static_cast<size_t>(t)]; },
                     [](double x, double y) { return std::max(x, y); });
 }
 
 std::vector<AABB> TriangleBvh::node_unions(const std::vector<AABB>& boxes) const {
-  std::vector<AABB> out(nodes_.size());
-  // Children come after their parent in nodes_, so a reverse pass sees them first.
-  for (size_t n = nodes_.size(); n-- > 0;) {
-    const Node& node = nodes_[n];
-    AABB box;
-    if (node.count > 0) {
-      for (std::int32_t k = node.first; k < node.first + node.count; ++k)
-        box.extend(boxes[static_cast<size_t>(order_[static_cast<size_t>(k)])]);
-    } else {
-      box = out[static_cast<size_t>(node.first)];
-      box.extend(out[static_cast<size_t>(node.first) + 1]);
-    }
-    out[n] = box;
-  }
-  return out;
+  return fold_nodes(AABB{}, [&](Index t) { return boxes[static_cast<size_t>(t)]; }, [](AABB x, const AABB& y) {
+    x.extend(y);
+    return x;
+  });
 }
 
 std::vector<std::array<Index, 3>> TriangleBvh::node_common_vertices(const std::vector<Face>& faces) const {

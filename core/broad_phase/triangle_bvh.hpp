@@ -183,6 +183,23 @@ class TriangleBvh {
       stack.push_back({a, nb.first});
     }
   }
+  /// Per node, combine() of leaf(t) over the triangles t of its subtree, from `init`: a leaf
+  /// folds its triangles in order, an inner node its two children's values. Children come after
+  /// their parent in nodes_, so a reverse pass sees them first.
+  template <typename T, typename Leaf, typename Combine>
+  std::vector<T> fold_nodes(const T& init, const Leaf& leaf, const Combine& combine) const {
+    std::vector<T> out(nodes_.size(), init);
+    for (size_t n = nodes_.size(); n-- > 0;) {
+      const Node& node = nodes_[n];
+      if (node.count > 0) {
+        for (std::int32_t k = node.first; k < node.first + node.count; ++k)
+          out[n] = combine(out[n], leaf(order_[static_cast<size_t>(k)]));
+      } else {
+        out[n] = combine(out[static_cast<size_t>(node.first)], out[static_cast<size_t>(node.first) + 1]);
+      }
+    }
+    return out;
+  }
   std::vector<Node> nodes_;
   std::vector<Index> order_;
   std::vector<AABB> leaf_boxes_;  ///< boxes in order_ order
@@ -286,12 +303,9 @@ template <typename Enter>
 std::vector<TriangleBvh::NodePair> TriangleBvh::self_pairs_below(std::int32_t max_triangles, const Enter& enter) const {
   std::vector<NodePair> out;
   if (nodes_.empty()) return out;
-  // Triangles per subtree; children come after their parent, so a reverse pass sees them first.
-  std::vector<std::int32_t> count(nodes_.size());
-  for (size_t n = nodes_.size(); n-- > 0;) {
-    const Node& node = nodes_[n];
-    count[n] = node.count > 0 ? node.count : count[static_cast<size_t>(node.first)] + count[static_cast<size_t>(node.first) + 1];
-  }
+  // Triangles per subtree.
+  const std::vector<std::int32_t> count =
+      fold_nodes(std::int32_t{0}, [](Index) { return std::int32_t{1}; }, [](std::int32_t x, std::int32_t y) { return x + y; });
   // The same expansion as descend_self(), in the same order, stopping at small pairs.
   std::vector<NodePair> stack;
   walk_self({0, 0}, stack, enter, [&](std::int32_t a, std::int32_t b, const Node& na, const Node& nb) {

@@ -1022,11 +1022,9 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
       // cloth-ball, and CCD's exact stage from 18.4 to 16.5 ms there (funnel: within its spread).
       const Face& ff = oi.topology->faces[static_cast<size_t>(f)];
       const Face& gf = oj.topology->faces[static_cast<size_t>(g)];
-      const bool touching = self && Adjacency::share_vertex(ff, gf);
-      if (touching) {
-        // Exactly one common vertex c (and three distinct corners each): f's other two
-        // corners against g's, around c (apart_around_vertex()).
-        int common = 0, fc = 0, gc = 0;
+      // Corners the two have in common (within one object), and where the last one is in each.
+      int common = 0, fc = 0, gc = 0;
+      if (self)
         for (int x = 0; x < 3; ++x)
           for (int y = 0; y < 3; ++y)
             if (ff[static_cast<size_t>(x)] == gf[static_cast<size_t>(y)]) {
@@ -1034,6 +1032,10 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
               fc = x;
               gc = y;
             }
+      const bool touching = common > 0;
+      if (touching) {
+        // Exactly one common vertex c (and three distinct corners each): f's other two
+        // corners against g's, around c (apart_around_vertex()).
         const bool distinct = ff[0] != ff[1] && ff[1] != ff[2] && ff[0] != ff[2] && gf[0] != gf[1] && gf[1] != gf[2] && gf[0] != gf[2];
         if (common == 1 && distinct) {
           auto others = [](const Object& o, const Face& face, int skip) {
