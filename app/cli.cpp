@@ -249,11 +249,15 @@ int cli_main(int argc, char** argv) {
                  "auto (gpu on a hardware GPU, else cpu). Default: off. Results are identical.")
       ->check(CLI::IsMember({"off", "cpu", "gpu", "auto"}));
   app.add_option("--grid", config.grid,
-                 "Voronoi grid: cells along the longest axis of the scene box (default: the "
-                 "scene's \"grid\", else per query: 4*cbrt(triangles) clamped to [32, 256] for "
-                 "the inter-object distance, sqrt(triangles) clamped to [32, 512] but cells no "
-                 "smaller than 0.7 median triangle for the intra-object distance, for CCD a "
-                 "cell from the triangles' sizes)")
+                 "Voronoi grid of the distance queries: cells along the longest axis of the scene "
+                 "box (default: the scene's \"grid\", else per query: 4*cbrt(triangles) clamped "
+                 "to [32, 256] for the inter-object distance, sqrt(triangles) clamped to [32, 512] "
+                 "but cells no smaller than 0.7 median triangle for the intra-object distance)")
+      ->check(whole_number(1, kMaxGridResolution, "cells along the longest axis"));
+  app.add_option("--ccd-grid", config.ccd_grid,
+                 "CCD's Stage II grid: cells along the longest axis of the swept box of the "
+                 "triangles it voxelizes, coarsened where they would cover thousands of voxels "
+                 "each (default: a cell from the triangles' sizes and motion)")
       ->check(whole_number(1, kMaxGridResolution, "cells along the longest axis"));
   app.add_option("--device", config.device, "EGL device index for --voronoi=gpu (default: first hardware device)")
       ->check(whole_number(0, 1023, "an EGL device index"));
@@ -267,11 +271,13 @@ int cli_main(int argc, char** argv) {
   return guarded([&] {
     if (!frames.empty()) config.frames = parse_frame_range(frames);
     if (app.count("--queries") > 0) config.queries = parse_query_list(queries);
-    g_out_of_memory_hint = config.voronoi == "off" ? "" : "; a coarser --grid (or --voronoi=off) needs less";
+    g_out_of_memory_hint = config.voronoi == "off" ? "" : "; a coarser --grid or --ccd-grid (or --voronoi=off) needs less";
     // Options that the chosen backend does not use: said once, so that a sweep over --grid
     // with the default --voronoi=off does not silently measure the same run again and again.
     if (!config.quiet && config.voronoi == "off" && config.grid > 0)
       std::fprintf(stderr, "vproxq: note: --grid has no effect with --voronoi=off\n");
+    if (!config.quiet && config.voronoi == "off" && config.ccd_grid > 0)
+      std::fprintf(stderr, "vproxq: note: --ccd-grid has no effect with --voronoi=off\n");
     if (!config.quiet && config.device >= 0 && (config.voronoi == "off" || config.voronoi == "cpu"))
       std::fprintf(stderr, "vproxq: note: --device has no effect with --voronoi=%s\n", config.voronoi.c_str());
     run(config);

@@ -18,6 +18,7 @@ struct Config {
   FrameRange frames;
   std::string voronoi = "off";  ///< off | cpu | gpu | auto (see README: off is fastest today)
   int grid = 0;                  ///< cells along the longest axis; 0: scene's "grid", else automatic
+  int ccd_grid = 0;              ///< CCD's Stage II grid, cells along the longest axis; 0: automatic
   int device = -1;               ///< EGL device index for gpu; -1: prefer a hardware device
   int threads = 0;               ///< 0: all hardware threads
   bool quiet = false;

@@ -328,7 +328,7 @@ void run(const Config& config) {
       // host, voxels and co-occupancy on the backend.
       CcdOptions ccd_options{info.threads};
       ccd_options.voxel_backend = voronoi.backend ? voronoi.ccd_backend.get() : nullptr;
-      ccd_options.voxel_grid = grid;
+      ccd_options.voxel_grid = config.ccd_grid;
       CcdStepResult c = continuous_collisions(frame, to, sweep, ccd_options);
       c.aabb_ms += sweep_ms;
       result.time_ms.aabb += c.aabb_ms;

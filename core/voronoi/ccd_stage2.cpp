@@ -58,7 +58,7 @@ constexpr double kCellFactor = 0.5;
 /// Upper bound on the estimated voxels visited per (triangle, slot) record, on average (the
 /// 200-blob scene visits ~17 with the factor above; the bound only bites on mixed sizes).
 constexpr double kRoomPerRecord = 80;
-/// The same bound for a grid given by --grid: it honours the grid unless the records would
+/// The same bound for a grid given by --ccd-grid: it honours the grid unless the records would
 /// cover some thousands of voxels each (a small scene far from the origin, where the culling
 /// margin dwarfs the triangles: at 1e12, --grid 128 took over 60 s and 19 GB, 200 ran out of
 /// memory; near the origin, --grid 4096 took 12.7 s and 5.2 GB on 200 triangles).

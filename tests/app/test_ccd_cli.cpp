@@ -120,7 +120,7 @@ TEST(CcdCli, BackendsGiveIdenticalResultsEqualToBruteForce) {
     for (const char* backend : {"off", "cpu", "gpu"}) {
       SCOPED_TRACE(backend);
       const auto out = dir / backend;
-      const auto r = vproxq(quote(scene) + " -o " + quote(out) + " --quiet --threads 2 --grid 24 --voronoi=" + backend);
+      const auto r = vproxq(quote(scene) + " -o " + quote(out) + " --quiet --threads 2 --ccd-grid 24 --voronoi=" + backend);
       ASSERT_EQ(r.exit_code, 0) << r.output;
       expect_equal_brute_force(scene, out, found);
     }
@@ -156,6 +156,41 @@ TEST(CcdCli, BackendsGiveIdenticalResultsEqualToBruteForce) {
     EXPECT_LT(tests_cpu, tests_off);
   }
   EXPECT_GT(found, 0u) << "the scenes must have collisions for the comparison to mean much";
+}
+
+// --grid is the distance queries' grid and leaves CCD's own alone; --ccd-grid sets CCD's
+// (finer CCD grids cost far more than they saved: README, "Continuous collision detection").
+TEST(CcdCli, CcdGridIsSetByCcdGridAlone) {
+  ScratchDir dir;
+  const fs::path scene = write_scene(dir, 3, 4, 3);
+  auto ccd_grids = [&](const std::string& options) {
+    const auto out = dir / ("run" + std::to_string(std::hash<std::string>{}(options)));
+    const auto r = vproxq(quote(scene) + " -o " + quote(out) + " --quiet --threads 2 --voronoi=cpu " + options);
+    EXPECT_EQ(r.exit_code, 0) << options << ": " << r.output;
+    std::vector<int> longest;
+    const auto j = read_json(out / "results.json");
+    for (const auto& f : j["frames"])
+      if (f["stats"].contains("ccd") && f["stats"]["ccd"].contains("grid"))
+        longest.push_back(std::max({f["stats"]["ccd"]["grid"][0].get<int>(), f["stats"]["ccd"]["grid"][1].get<int>(),
+                                    f["stats"]["ccd"]["grid"][2].get<int>()}));
+    return longest;
+  };
+  const std::vector<int> automatic = ccd_grids("");
+  ASSERT_FALSE(automatic.empty());
+  EXPECT_EQ(ccd_grids("--grid 24"), automatic);
+  EXPECT_EQ(ccd_grids("--grid 24 --ccd-grid 24"), std::vector<int>(automatic.size(), 25));
+  EXPECT_EQ(ccd_grids("--ccd-grid 24"), std::vector<int>(automatic.size(), 25));
+  EXPECT_NE(automatic, std::vector<int>(automatic.size(), 25));
+  // Like --grid, it has no effect without Stage II, and says so.
+  const auto r = vproxq(quote(scene) + " --ccd-grid 24 -o " + quote(dir / "off"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("note: --ccd-grid has no effect with --voronoi=off"), std::string::npos) << r.output;
+  for (const char* bad : {"--ccd-grid=0", "--ccd-grid=4097", "--ccd-grid=x"}) {
+    const auto b = vproxq(quote(scene) + " " + bad + " --voronoi=cpu -o " + quote(dir / "bad"));
+    EXPECT_EQ(b.exit_code, 2) << bad << ": " << b.output;
+    EXPECT_NE(b.output.find("--ccd-grid"), std::string::npos) << b.output;
+    EXPECT_FALSE(fs::exists(dir / "bad")) << bad;
+  }
 }
 
 TEST(CcdCli, TopologyChangeIsSkippedWithReason) {
