@@ -196,8 +196,9 @@ struct CcdCounters {
   /// Of those, pairs shown apart for the whole step along a separating axis (no tests ran); for
   /// two triangles of one object sharing one vertex, all their primitive pairs along one axis.
   std::uint64_t separated_pairs = 0;
-  /// Of the rest, pairs Stage II rules out (no tests ran): inter-object, one of the two
-  /// triangles has no (slot, voxel) key that another object marks; or the two share no key.
+  /// Of the rest, pairs Stage II rules out (no tests ran; it looks at inter-object pairs only):
+  /// one of the two triangles has no (slot, voxel) key that another object marks, or the two
+  /// share no key.
   std::uint64_t unshared_pairs = 0;
   /// Primitive pairs (vertex–face, edge–edge) shown apart for the whole step along a
   /// separating axis (no test ran).
@@ -208,7 +209,8 @@ struct CcdCounters {
   /// Inter-object: (object pair, triangle of the first) whose candidate pairs Stage II drops
   /// whole, the triangle having no key that another object marks.
   std::uint64_t culled_triangles = 0;
-  /// Triangles Stage II voxelized (those of the pairs left after the separating-axis tests).
+  /// Triangles Stage II voxelized (those of the inter-object pairs left after the
+  /// separating-axis tests).
   std::uint64_t voxelized_triangles = 0;
   std::uint64_t elementary_tests() const { return vf_tests + ee_tests; }
 };

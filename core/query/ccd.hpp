@@ -16,9 +16,10 @@
 // axis through that vertex shows all their primitive pairs apart), and so is each primitive
 // pair of the remaining triangle pairs that the same argument shows apart
 // (CcdCounters::separated_primitives). Optional Stage II
-// (core/voronoi/ccd_stage2.hpp) culls the triangle pairs left after the separating-axis tests
-// (of the pairs and of their primitives) with a voxelization of the swept prisms: of those
-// pairs' triangles only, when built here.
+// (core/voronoi/ccd_stage2.hpp) culls the inter-object triangle pairs left after the
+// separating-axis tests (of the pairs and of their primitives) with a voxelization of the swept
+// prisms: of those pairs' triangles only, when built here. Pairs within one object go from
+// Stage I to Stage III (Stage II nearly never ruled one out: ccd.cpp).
 // Stage III: the elementary tests of core/geometry/ccd.hpp, each vertex–face and edge–edge pair
 // tested once (see ccd.cpp for the ownership rule that deduplicates without a global set).
 //
@@ -56,8 +57,8 @@ struct CcdOptions {
   /// caller for this step (ccd_stage2.hpp), or null. It never changes the answer.
   const CcdVoxelCulling* voxels = nullptr;
   /// Or, when `voxels` is null, Stage II built here with this backend after Stage I, over the
-  /// triangles of the candidate pairs Stage I leaves (not shown apart, and with a primitive
-  /// pair not shown apart: the only pairs whose keys are ever looked at); the result's
+  /// triangles of the inter-object candidate pairs Stage I leaves (not shown apart, and with a
+  /// primitive pair not shown apart: the only pairs whose keys are ever looked at); the result's
   /// voronoi_ms, voxel_grid, voxel_cell and counters.voxelized_triangles describe it.
   CcdVoxelBackend* voxel_backend = nullptr;
   int voxel_grid = 0;   ///< its CcdVoxelOptions::grid_resolution (0: automatic)
