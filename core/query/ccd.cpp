@@ -808,13 +808,13 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
     for (Index t = 0; t < n; t += kChunk) tasks.push_back({i, j, p, t, std::min(n, t + kChunk)});
   }
   const Tester tester(from, to);
-  // Stage II runs on the triangle pairs that Stage I leaves: pairs not shown apart, with at
-  // least one primitive pair not shown apart. It is given by the caller, or built here over
-  // those pairs' triangles once Stage I has listed them: a reportable primitive pair is tested
-  // in its owner triangles' pair, which is then listed, so both triangles are voxelized and the
-  // culling argument of ccd_stage2.hpp holds for it. Without Stage II, each pair goes straight
-  // to its primitive tests.
-  // Stage II culls inter-object pairs only. Within one object it ruled out almost nothing
+  // Stage II runs on the inter-object triangle pairs that Stage I leaves: pairs not shown
+  // apart, with at least one primitive pair not shown apart. It is given by the caller, or
+  // built here over those pairs' triangles once Stage I has listed them: a reportable primitive
+  // pair is tested in its owner triangles' pair, which is then listed, so both triangles are
+  // voxelized and the culling argument of ccd_stage2.hpp holds for it. Without Stage II, and
+  // for pairs within one object, each pair goes straight to its primitive tests.
+  //   Stage II culls inter-object pairs only. Within one object it ruled out almost nothing
   // while most of the triangles it voxelized were there for such pairs alone: on the report
   // scenes' steps 10-18 (2 threads, sums over the 9 steps) it culled 0-66 of 1,279-103,966
   // pairs within objects (against 0-43 of 543-25,498 between objects), and leaving those pairs

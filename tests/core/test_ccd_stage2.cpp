@@ -294,8 +294,8 @@ TEST(CcdStage2, PairsWithinOneObjectAreLeftToStageOne) {
     EXPECT_EQ(r.counters.elementary_tests(), off.counters.elementary_tests());
     EXPECT_GT(off.counters.elementary_tests(), 0u);
   }
-  // Two folding objects apart from each other but for a corner: only triangles near that
-  // corner are voxelized.
+  // Two folding objects that overlap along a strip: only triangles of pairs between them are
+  // voxelized.
   Frame from = test::make_random_frame(71, 1, 1.0, 2);
   from.index = 0;
   Object other = from.objects[0];
@@ -316,7 +316,8 @@ TEST(CcdStage2, PairsWithinOneObjectAreLeftToStageOne) {
   const auto all = static_cast<std::uint64_t>(from.objects[0].num_triangles() + from.objects[1].num_triangles());
   EXPECT_GT(r.counters.voxelized_triangles, 0u);
   EXPECT_LT(4 * r.counters.voxelized_triangles, all) << r.counters.voxelized_triangles << " of " << all;
-  std::printf("[          ] two objects: %llu of %llu triangles voxelized\n", static_cast<unsigned long long>(r.counters.voxelized_triangles), static_cast<unsigned long long>(all));
+  std::printf("[          ] two objects: %llu of %llu triangles voxelized\n",
+              static_cast<unsigned long long>(r.counters.voxelized_triangles), static_cast<unsigned long long>(all));
 }
 
 // Far from the origin the culling margin (it grows with the coordinates' magnitude) can
