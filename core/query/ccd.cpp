@@ -983,23 +983,21 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
     };
 
     if (replay) {
-      // Stage II's checks, then Stage III. Inter-object: a triangle none of whose keys another
-      // object marks takes part in no collision (counted once per triangle and task, the
-      // pairs of its run all dropped); then the pair must share a key.
+      // Stage II's checks, then Stage III (only inter-object tasks list candidates): a triangle
+      // none of whose keys another object marks takes part in no collision (counted once per
+      // triangle and task, the pairs of its run all dropped); then the pair must share a key.
       Index last_f = kNoIndex;
       bool f_kept = true;
       for (const Candidate& cand : candidates[k]) {
         const Index f = cand.f, g = cand.g;
-        if (!self) {
-          if (f != last_f) {
-            last_f = f;
-            f_kept = voxels->keeps(i, f);
-            if (!f_kept) ++hits.counters.culled_triangles;
-          }
-          if (!f_kept || !voxels->keeps(j, g)) {
-            ++hits.counters.unshared_pairs;
-            continue;
-          }
+        if (f != last_f) {
+          last_f = f;
+          f_kept = voxels->keeps(i, f);
+          if (!f_kept) ++hits.counters.culled_triangles;
+        }
+        if (!f_kept || !voxels->keeps(j, g)) {
+          ++hits.counters.unshared_pairs;
+          continue;
         }
         if (!voxels->share_voxel(i, f, j, g)) {
           ++hits.counters.unshared_pairs;
