@@ -16,6 +16,7 @@
 #include "gl/self_voronoi_backend.hpp"
 #include "gl/voronoi_backend.hpp"
 #include "io/output.hpp"
+#include "io/pipeline.hpp"
 #include "io/scene_source.hpp"
 
 #include <algorithm>
@@ -246,14 +247,21 @@ void run(const Config& config) {
   info.device = voronoi.backend ? voronoi.backend->device() : "";
   info.grid = voronoi.backend ? grid : 0;
 
-  std::unique_ptr<ResultWriter> writer;
-  if (!config.output_dir.empty()) writer = std::make_unique<ResultWriter>(config.output_dir, info);
+  // Each frame's results are written on a background thread while the next frame is computed.
+  std::unique_ptr<BackgroundWriter> writer;
+  if (!config.output_dir.empty())
+    writer = std::make_unique<BackgroundWriter>(std::make_unique<ResultWriter>(config.output_dir, info));
 
   const bool want_distance = std::find(queries.begin(), queries.end(), "distance") != queries.end();
   const bool want_pd = std::find(queries.begin(), queries.end(), "pd") != queries.end();
   const bool want_ccd = std::find(queries.begin(), queries.end(), "ccd") != queries.end();
   // CCD of frame k covers the step k -> k+1 whenever the scene has frame k+1 (also past the
   // end of --frames); that frame is loaded once and reused as the next frame of the loop.
+  // Frames are read in order, each on a background thread while the one before it is in use
+  // (`load` is the time the loop waited for them): frames first .. last-1, and frame last too
+  // with CCD when the scene has it.
+  const long read_end = want_ccd ? std::min(last + 1, count) : last;
+  FrameReadAhead reader(scene, static_cast<std::size_t>(first), static_cast<std::size_t>(read_end));
   std::optional<Frame> next_frame;
   StaticIntraCache static_intra;
   Progress progress(info.frame_count, !config.quiet);
@@ -262,11 +270,9 @@ void run(const Config& config) {
     FrameResult result;
     result.frame = static_cast<int>(k);
     Stopwatch sw;
-    const Frame frame = next_frame && next_frame->index == k
-                            ? std::move(*next_frame)
-                            : scene.load_frame(static_cast<std::size_t>(k));
+    const Frame frame = next_frame && next_frame->index == k ? std::move(*next_frame) : reader.next();
     next_frame.reset();
-    if (want_ccd && k + 1 < count) next_frame = scene.load_frame(static_cast<std::size_t>(k + 1));
+    if (want_ccd && k + 1 < count) next_frame = reader.next();
     result.time_ms.load = sw.elapsed_ms();
     result.files = frame.files;
     for (std::size_t i = 0; i < frame.objects.size(); ++i) {
@@ -339,7 +345,7 @@ void run(const Config& config) {
     result.time_ms.total = total.elapsed_ms();
     if (writer) {
       // write_frame() fills in and adds its own time before serialising the stats.
-      writer->write_frame(result);
+      writer->write_frame(std::move(result));
     } else if (!config.quiet) {
       progress.clear();
       std::fflush(stdout);

@@ -209,6 +209,30 @@ TEST(Cli, InputErrorsNameTheFileAndLeaveNoOutput) {
   }
 }
 
+// Frames are read one ahead on a background thread: a bad frame still fails the run only when
+// the run needs it (frame 2 below: not for --frames 0:2, but for CCD's step 1 -> 2), with the
+// same message and exit code and no output, whichever frames were computed before.
+TEST(Cli, ABadFrameFailsOnlyARunThatNeedsIt) {
+  const std::string good = "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no b\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf 4 5 6\n";
+  ScratchDir dir;
+  for (int k = 0; k < 4; ++k)
+    dir.write("frame_" + std::to_string(k) + ".obj", k == 2 ? std::string("o a\nv 0 0 zero\n") : good);
+  const auto scene = dir.write("scene.json", R"({"frames": {"pattern": "frame_%d.obj", "first": 0, "count": 4}})");
+  const auto out = dir / "out";
+  auto r = vproxq(quote(scene) + " --frames 0:2 -o " + quote(out) + " --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(read_json(out / "results.json")["frames"].size(), 2u);
+  fs::remove_all(out);
+  for (const std::string& args : {std::string(" --frames 0:2 --queries distance,ccd"), std::string(""),
+                                  std::string(" --frames 1: --voronoi=cpu --queries distance,ccd,pd")}) {
+    SCOPED_TRACE(args);
+    r = vproxq(quote(scene) + args + " -o " + quote(out) + " --quiet");
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    EXPECT_NE(r.output.find("frame_2.obj"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out)) << r.output;
+  }
+}
+
 // A failed run removes the output directories it created (all of a nested -o path), and
 // leaves an existing directory and what was in it alone.
 // A run ended by SIGTERM or SIGHUP (a timeout, a closed terminal; SIGINT is handled the same

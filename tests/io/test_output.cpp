@@ -2,6 +2,7 @@
 #include "core/errors.hpp"
 #include "io/hdf5_reader.hpp"
 #include "io/output.hpp"
+#include "io/pipeline.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -508,6 +509,56 @@ TEST_F(OutputTest, AbortLeavesNoFiles) {
     writer.write_frame(make_frames()[0]);
   }
   EXPECT_EQ(dir_entries(out()), std::vector<std::string>{"mine.txt"});
+}
+
+// BackgroundWriter: the same files as ResultWriter (but for each frame's write time), frames
+// in the order given, each write done before the next one starts.
+TEST_F(OutputTest, BackgroundWriterWritesWhatTheWriterWrites) {
+  write_all(make_info(), make_frames());
+  const fs::path direct = dir_ / "direct";
+  fs::rename(out(), direct);
+  {
+    BackgroundWriter writer(std::make_unique<ResultWriter>(out(), make_info()));
+    for (FrameResult f : make_frames()) writer.write_frame(std::move(f));
+    writer.commit();
+  }
+  EXPECT_EQ(dir_entries(out()), (std::vector<std::string>{"results.h5", "results.json"}));
+  json a = json::parse(read_text(direct / "results.json"));
+  json b = json::parse(read_text(out() / "results.json"));
+  ASSERT_EQ(a["frames"].size(), make_frames().size());
+  ASSERT_EQ(b["frames"].size(), a["frames"].size());
+  for (std::size_t k = 0; k < a["frames"].size(); ++k) {
+    EXPECT_GE(b["frames"][k]["stats"]["time_ms"]["write"].get<double>(), 0.0);
+    a["frames"][k]["stats"]["time_ms"].erase("write");
+    b["frames"][k]["stats"]["time_ms"].erase("write");
+  }
+  EXPECT_EQ(a, b);
+  Hdf5Reader h5(out() / "results.h5");
+  EXPECT_EQ(h5.children("/frames").size(), make_frames().size());
+}
+
+// Without commit(), nothing is left, also when the last write is still running; a write's
+// error comes back from the next call that waits for it.
+TEST_F(OutputTest, BackgroundWriterAbortAndErrors) {
+  {
+    BackgroundWriter writer(std::make_unique<ResultWriter>(out(), make_info()));
+    for (FrameResult f : make_frames()) writer.write_frame(std::move(f));
+  }
+  EXPECT_FALSE(fs::exists(out()));
+  {
+    BackgroundWriter writer(std::make_unique<ResultWriter>(out(), make_info()));
+    writer.write_frame(make_frames()[0]);
+    writer.commit();
+    writer.write_frame(make_frames()[1]);  // fails on the writer's thread: already committed
+    try {
+      writer.write_frame(make_frames()[2]);  // waits for the failed write
+      ADD_FAILURE() << "the failed write was not reported";
+    } catch (const RuntimeError& e) {
+      EXPECT_NE(std::string(e.what()).find("already committed"), std::string::npos) << e.what();
+    }
+  }
+  const json doc = json::parse(read_text(out() / "results.json"));
+  EXPECT_EQ(doc["frames"].size(), 1u);
 }
 
 TEST_F(OutputTest, AbortKeepsEarlierResultsIntact) {

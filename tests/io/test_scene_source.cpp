@@ -1,4 +1,5 @@
 // SceneSource: scene.json variants, bare mesh files, frame loading, and every bad key.
+#include "io/pipeline.hpp"
 #include "io/scene_source.hpp"
 #include "io_test_util.hpp"
 
@@ -71,6 +72,43 @@ TEST_F(SceneSourceTest, PatternFramesLoadOnRequest) {
   EXPECT_EQ(f1.objects[0].topology.get(), f2.objects[0].topology.get());
   EXPECT_EQ(f1.objects[1].topology.get(), f2.objects[1].topology.get());
   EXPECT_NE(f2.objects[0].topology.get(), f2.objects[1].topology.get());
+}
+
+// FrameReadAhead hands out frames first .. end-1 in order, as load_frame() gives them (the
+// topologies of unchanged faces shared, which needs the reads in order), and a frame's read
+// error only when that frame is asked for: the frames before it come back whole even when its
+// read (started as soon as the one before it was handed out) has failed meanwhile.
+TEST_F(SceneSourceTest, FramesAreReadAheadInOrderWithTheirOwnErrors) {
+  for (int k = 0; k < 5; ++k) {
+    char name[64];
+    std::snprintf(name, sizeof name, "frames/f_%d.obj", k);
+    dir.write(name, k == 3 ? std::string("o a\nv 0 0 zero\n") : triangles_obj({"a", "b"}, k));
+  }
+  const SceneSource s = SceneSource::open(scene(R"({"frames": {"pattern": "frames/f_%d.obj", "first": 0, "count": 5}})"));
+  FrameReadAhead reader(s, 1, 4);
+  EXPECT_EQ(reader.next_index(), 1u);
+  const Frame f1 = reader.next();
+  const Frame f2 = reader.next();
+  EXPECT_EQ(reader.next_index(), 3u);
+  EXPECT_EQ(f1.index, 1);
+  EXPECT_EQ(f2.index, 2);
+  EXPECT_EQ(f1.objects[1].positions[0], Vec3(11, 0, 0));
+  EXPECT_EQ(f2.objects[1].positions[0], Vec3(12, 0, 0));
+  EXPECT_EQ(f1.objects[0].topology.get(), f2.objects[0].topology.get());
+  EXPECT_EQ(f1.objects[1].topology.get(), f2.objects[1].topology.get());
+  try {
+    reader.next();
+    ADD_FAILURE() << "frame 3 is malformed";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("f_3.obj"), std::string::npos) << e.what();
+  }
+
+  // Given up on with a read still running, or with nothing left to read: no error.
+  { FrameReadAhead unused(s, 0, 5); }
+  { FrameReadAhead empty(s, 2, 2); }
+  FrameReadAhead last(s, 4, 5);
+  EXPECT_EQ(last.next().index, 4);
+  EXPECT_EQ(last.next_index(), 5u);
 }
 
 TEST_F(SceneSourceTest, FileListDefaultNameAndPercentInPattern) {
