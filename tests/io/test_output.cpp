@@ -518,7 +518,7 @@ TEST_F(OutputTest, BackgroundWriterWritesWhatTheWriterWrites) {
   const fs::path direct = dir_ / "direct";
   fs::rename(out(), direct);
   {
-    BackgroundWriter writer(std::make_unique<ResultWriter>(out(), make_info()));
+    BackgroundWriter writer(std::make_unique<ResultWriter>(out(), make_info()), 0.0);  // all on the worker
     for (FrameResult f : make_frames()) writer.write_frame(std::move(f));
     writer.commit();
   }
@@ -541,12 +541,12 @@ TEST_F(OutputTest, BackgroundWriterWritesWhatTheWriterWrites) {
 // error comes back from the next call that waits for it.
 TEST_F(OutputTest, BackgroundWriterAbortAndErrors) {
   {
-    BackgroundWriter writer(std::make_unique<ResultWriter>(out(), make_info()));
+    BackgroundWriter writer(std::make_unique<ResultWriter>(out(), make_info()), 0.0);
     for (FrameResult f : make_frames()) writer.write_frame(std::move(f));
   }
   EXPECT_FALSE(fs::exists(out()));
   {
-    BackgroundWriter writer(std::make_unique<ResultWriter>(out(), make_info()));
+    BackgroundWriter writer(std::make_unique<ResultWriter>(out(), make_info()), 0.0);
     writer.write_frame(make_frames()[0]);
     writer.commit();
     writer.write_frame(make_frames()[1]);  // fails on the writer's thread: already committed

@@ -84,31 +84,38 @@ TEST_F(SceneSourceTest, FramesAreReadAheadInOrderWithTheirOwnErrors) {
     std::snprintf(name, sizeof name, "frames/f_%d.obj", k);
     dir.write(name, k == 3 ? std::string("o a\nv 0 0 zero\n") : triangles_obj({"a", "b"}, k));
   }
-  const SceneSource s = SceneSource::open(scene(R"({"frames": {"pattern": "frames/f_%d.obj", "first": 0, "count": 5}})"));
-  FrameReadAhead reader(s, 1, 4);
-  EXPECT_EQ(reader.next_index(), 1u);
-  const Frame f1 = reader.next();
-  const Frame f2 = reader.next();
-  EXPECT_EQ(reader.next_index(), 3u);
-  EXPECT_EQ(f1.index, 1);
-  EXPECT_EQ(f2.index, 2);
-  EXPECT_EQ(f1.objects[1].positions[0], Vec3(11, 0, 0));
-  EXPECT_EQ(f2.objects[1].positions[0], Vec3(12, 0, 0));
-  EXPECT_EQ(f1.objects[0].topology.get(), f2.objects[0].topology.get());
-  EXPECT_EQ(f1.objects[1].topology.get(), f2.objects[1].topology.get());
-  try {
-    reader.next();
-    ADD_FAILURE() << "frame 3 is malformed";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("f_3.obj"), std::string::npos) << e.what();
-  }
+  // inline_ms 0: every read after the first on the worker; 1e9: every read in line.
+  for (const double inline_ms : {0.0, 1e9}) {
+    SCOPED_TRACE(inline_ms);
+    const SceneSource s = SceneSource::open(scene(R"({"frames": {"pattern": "frames/f_%d.obj", "first": 0, "count": 5}})"));
+    FrameReadAhead reader(s, 1, 4, inline_ms);
+    EXPECT_EQ(reader.next_index(), 1u);
+    const Frame f1 = reader.next();
+    const Frame f2 = reader.next();
+    EXPECT_EQ(reader.next_index(), 3u);
+    EXPECT_EQ(f1.index, 1);
+    EXPECT_EQ(f2.index, 2);
+    EXPECT_EQ(f1.objects[1].positions[0], Vec3(11, 0, 0));
+    EXPECT_EQ(f2.objects[1].positions[0], Vec3(12, 0, 0));
+    EXPECT_EQ(f1.objects[0].topology.get(), f2.objects[0].topology.get());
+    EXPECT_EQ(f1.objects[1].topology.get(), f2.objects[1].topology.get());
+    try {
+      reader.next();
+      ADD_FAILURE() << "frame 3 is malformed";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("f_3.obj"), std::string::npos) << e.what();
+    }
 
-  // Given up on with a read still running, or with nothing left to read: no error.
-  { FrameReadAhead unused(s, 0, 5); }
-  { FrameReadAhead empty(s, 2, 2); }
-  FrameReadAhead last(s, 4, 5);
-  EXPECT_EQ(last.next().index, 4);
-  EXPECT_EQ(last.next_index(), 5u);
+    // Given up on with a read still running, or with nothing left to read: no error.
+    {
+      FrameReadAhead unused(s, 0, 5, inline_ms);
+      EXPECT_EQ(unused.next().index, 0);
+    }
+    { FrameReadAhead empty(s, 2, 2, inline_ms); }
+    FrameReadAhead last(s, 4, 5, inline_ms);
+    EXPECT_EQ(last.next().index, 4);
+    EXPECT_EQ(last.next_index(), 5u);
+  }
 }
 
 TEST_F(SceneSourceTest, FileListDefaultNameAndPercentInPattern) {
