@@ -258,8 +258,8 @@ void run(const Config& config) {
   // CCD of frame k covers the step k -> k+1 whenever the scene has frame k+1 (also past the
   // end of --frames); that frame is loaded once and reused as the next frame of the loop.
   // Frames are read in order, each on a background thread while the one before it is in use
-  // (`load` is the time the loop waited for them): frames first .. last-1, and frame last too
-  // with CCD when the scene has it.
+  // (in line when reads are quick; `load` is the time the loop waited for them): frames
+  // first .. last-1, and frame last too with CCD when the scene has it.
   const long read_end = want_ccd ? std::min(last + 1, count) : last;
   FrameReadAhead reader(scene, static_cast<std::size_t>(first), static_cast<std::size_t>(read_end));
   std::optional<Frame> next_frame;
