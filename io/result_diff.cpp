@@ -1,6 +1,7 @@
 #include "io/result_diff.hpp"
 
 #include "core/errors.hpp"
+#include "io/json_check.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -9,6 +10,8 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <iterator>
+#include <sstream>
 #include <optional>
 #include <system_error>
 
@@ -37,15 +40,19 @@ Json load_results(const fs::path& file) {
   }
   Json doc;
   // A results file is a few levels deep; comparing a far deeper document would recurse that
-  // deep.
+  // deep. A key given twice in one object would compare only its last value.
   constexpr int kMaxDepth = 64;
+  // Read whole first: the check and the parse both go through it, and a pipe (`vproxq diff
+  // <(jq . a.json) b.json`) cannot be read twice.
+  std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (in.bad()) throw InputError("cannot read results file '" + file.string() + "': " + std::strerror(errno));
+  {
+    std::istringstream check(text);
+    const std::string problem = json_structure_problem(check, kMaxDepth, /*unique_keys=*/true);
+    if (!problem.empty()) throw InputError("malformed results file '" + file.string() + "': " + problem);
+  }
   try {
-    doc = Json::parse(in, [&](int depth, Json::parse_event_t, Json&) {
-      if (depth > kMaxDepth)
-        throw InputError("malformed results file '" + file.string() + "': nested more than " +
-                         std::to_string(kMaxDepth) + " levels deep");
-      return true;
-    });
+    doc = Json::parse(text);
   } catch (const nlohmann::json::exception& e) {
     throw InputError("malformed results file '" + file.string() + "': " + e.what());
   }

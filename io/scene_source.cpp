@@ -1,5 +1,7 @@
 #include "io/scene_source.hpp"
 
+#include "io/json_check.hpp"
+
 #include "core/errors.hpp"
 #include "io/mesh_reader.hpp"
 #include "io/mesh_reader_detail.hpp"
@@ -14,6 +16,7 @@
 #include <iterator>
 #include <mutex>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string_view>
 
@@ -321,21 +324,16 @@ void parse_scene_json(SceneImpl& s) {
   const std::string where = s.path.string();
   json root;
   // A scene is a few levels deep; far deeper nesting is no scene, and printing or walking it
-  // would recurse that deep.
+  // would recurse that deep. A key given twice in one object would silently keep the last.
   constexpr int kMaxDepth = 64;
-  // Keys seen in each object being parsed: a key given twice would silently keep the last.
-  std::vector<std::set<std::string>> keys;
+  {
+    std::istringstream in(text);
+    const std::string problem = json_structure_problem(in, kMaxDepth, /*unique_keys=*/true);
+    if (!problem.empty()) throw InputError(where + ": invalid JSON: " + problem);
+  }
   try {
-    root = json::parse(text, [&](int depth, json::parse_event_t event, json& parsed) {
-      if (depth > kMaxDepth)
-        throw InputError(where + ": invalid JSON: nested more than " + std::to_string(kMaxDepth) + " levels deep");
-      if (event == json::parse_event_t::object_start) keys.emplace_back();
-      if (event == json::parse_event_t::object_end) keys.pop_back();
-      if (event == json::parse_event_t::key && !keys.back().insert(parsed.get<std::string>()).second)
-        throw InputError(where + ": invalid JSON: the key " + parsed.dump() + " appears twice in one object");
-      return true;
-    });
-  } catch (const json::parse_error& e) {
+    root = json::parse(text);
+  } catch (const json::exception& e) {  // syntax errors, and numbers beyond double's range
     throw InputError(where + ": invalid JSON: " + e.what());
   }
   if (!root.is_object())

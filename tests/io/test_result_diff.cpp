@@ -8,6 +8,10 @@
 
 #include <fstream>
 #include <string>
+#include <thread>
+#include <utility>
+
+#include <sys/stat.h>
 
 #include <unistd.h>
 
@@ -272,6 +276,33 @@ TEST_F(DiffTest, MalformedFileThrowsInputErrorNamingIt) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("nested more than"), std::string::npos) << e.what();
   }
+  // A key given twice in one object (only the last value would be compared), and a number
+  // beyond double's range, are malformed too.
+  const fs::path twice = save_text("twice.json", R"({"frames": [{"frame": 0, "x": 1, "x": 2}]})");
+  const fs::path once = save_text("once.json", R"({"frames": [{"frame": 0, "x": 2}]})");
+  const fs::path huge = save_text("huge.json", R"({"frames": [{"frame": 0, "x": 1e400}]})");
+  for (const auto& [file, phrase] : {std::pair{twice, "the key \"x\" appears twice in one object"},
+                                     std::pair{huge, "number overflow"}}) {
+    try {
+      diff_result_files(file, once, {});
+      ADD_FAILURE() << "expected InputError for " << file;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("malformed results file '" + file.string() + "': "), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(phrase), std::string::npos) << e.what();
+    }
+  }
+}
+
+// A results file can come through a pipe (`vproxq diff <(jq . a.json) b.json`): it is read once.
+TEST_F(DiffTest, AResultsFileCanBeAPipe) {
+  const Json doc = base_document();
+  const fs::path file = save("file.json", doc);
+  const fs::path fifo = dir_ / "fifo.json";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::thread writer([&] { std::ofstream(fifo) << doc.dump(); });
+  const DiffOutcome outcome = diff_result_files(fifo, file, {});
+  writer.join();
+  EXPECT_TRUE(outcome.equal) << outcome.first_difference;
 }
 
 TEST_F(DiffTest, MissingFileThrowsInputErrorNamingIt) {

@@ -386,6 +386,11 @@ TEST_F(SceneSourceTest, EveryBadKeyIsReported) {
       {R"({"frames": {"files": ["/dev/null"]}})", {"\"frames.files[0]\" frame 0: not a regular file: /dev/null"}},
       {R"({"frames": {"files": ["a_0.obj"]}, "frames": {"files": ["a_1.obj"]}})",
        {"invalid JSON: the key \"frames\" appears twice in one object"}},
+      {R"({"frames": {"files": ["a_0.obj"]}, "objects": [{"a": 1, "b": {"a": 2}}, {"a": 3, "a": 4}]})",
+       {"invalid JSON: the key \"a\" appears twice in one object"}},
+      // A number beyond double's range is malformed JSON too (it was a runtime error, exit 4).
+      {R"({"frames": {"files": ["a_0.obj"]}, "grid": 1e400})", {"invalid JSON: ", "number overflow", "1e400"}},
+      {R"({"frames": {"files": ["a_0.obj"]}, "unknown": -1e400})", {"invalid JSON: ", "number overflow"}},
       {R"({"frames": {"files": ["a_0.obj\u0000x"]}})",
        {"\"frames.files[0]\" must not contain a NUL character"}},
       {R"({"frames": {"files": ["a_0.obj", "b.obj"]}})",
