@@ -153,6 +153,14 @@ int parse_or_exit(CLI::App& app, int argc, char** argv, bool& done) {
                    arg.substr(0, arg.size() - 1).c_str());
       return exit_code::kUsage;
     }
+    // The short form takes its value after a space or directly (-o OUT, -oOUT): `-o=OUT` would
+    // write into a directory named "=OUT".
+    if (arg.compare(0, 3, "-o=") == 0) {
+      done = true;
+      std::fprintf(stderr, "vproxq: usage error: %s: write -o %s or --output=%s (a directory whose name starts with '=': -o ./%s)\nRun with --help for the options.\n",
+                   arg.c_str(), arg.substr(3).c_str(), arg.substr(3).c_str(), arg.substr(2).c_str());
+      return exit_code::kUsage;
+    }
   }
   try {
     app.parse(argc, argv);

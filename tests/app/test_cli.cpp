@@ -106,7 +106,10 @@ TEST(Cli, UsageErrors) {
            {scene + " --queries=, -q", "--queries ',': an empty item"},
            {"--queries=, " + scene, "--queries ',': an empty item"},
            {scene + " --queries= -q", "--queries has no value"},
-           {scene + " --frames= -q", "--frames has no value"}}) {
+           {scene + " --frames= -q", "--frames has no value"},
+           // -o=OUT would write into a directory named "=OUT".
+           {scene + " -o=out -q", "-o=out: write -o out or --output=out"},
+           {scene + " -o= -q", "-o=: write -o "}}) {
     SCOPED_TRACE(args);
     r = vproxq(args);
     EXPECT_EQ(r.exit_code, 2) << r.output;
