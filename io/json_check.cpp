@@ -14,7 +14,8 @@ using json = nlohmann::json;
 /// SAX handler that stops (returns false) at the first problem, which it keeps.
 class StructureCheck final : public nlohmann::json_sax<json> {
  public:
-  StructureCheck(int max_depth, bool unique_keys) : max_depth_(max_depth), unique_keys_(unique_keys) {}
+  StructureCheck(int max_depth, bool unique_keys, bool integers_fit)
+      : max_depth_(max_depth), unique_keys_(unique_keys), integers_fit_(integers_fit) {}
 
   const std::string& problem() const { return problem_; }
 
@@ -22,7 +23,11 @@ class StructureCheck final : public nlohmann::json_sax<json> {
   bool boolean(bool) override { return true; }
   bool number_integer(number_integer_t) override { return true; }
   bool number_unsigned(number_unsigned_t) override { return true; }
-  bool number_float(number_float_t, const string_t&) override { return true; }
+  bool number_float(number_float_t, const string_t& text) override {
+    if (!integers_fit_ || text.find_first_of(".eE") != string_t::npos) return true;
+    problem_ = "the integer " + text + " does not fit in 64 bits";
+    return false;
+  }
   bool string(string_t&) override { return true; }
   bool binary(binary_t&) override { return true; }
   bool start_object(std::size_t) override {
@@ -56,7 +61,7 @@ class StructureCheck final : public nlohmann::json_sax<json> {
   }
 
   int max_depth_;
-  bool unique_keys_;
+  bool unique_keys_, integers_fit_;
   int depth_ = 0;
   std::vector<std::set<std::string>> keys_;  ///< per object being read, its keys so far
   std::string problem_;
@@ -64,8 +69,8 @@ class StructureCheck final : public nlohmann::json_sax<json> {
 
 }  // namespace
 
-std::string json_structure_problem(std::istream& in, int max_depth, bool unique_keys) {
-  StructureCheck check(max_depth, unique_keys);
+std::string json_structure_problem(std::istream& in, int max_depth, bool unique_keys, bool integers_fit) {
+  StructureCheck check(max_depth, unique_keys, integers_fit);
   json::sax_parse(in, &check, nlohmann::detail::input_format_t::json, /*strict=*/true);
   return check.problem();
 }

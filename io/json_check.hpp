@@ -9,10 +9,12 @@
 namespace vproxq {
 
 /// What is wrong with the structure of the JSON text `in` holds: nested more than `max_depth`
-/// arrays and objects deep, or (with `unique_keys`) a key given twice in one object, as a
-/// phrase for a message ("nested more than 64 levels deep", "the key \"a\" appears twice in one
-/// object"); "" when neither. A syntax error ends the pass with "": the parse that follows
+/// arrays and objects deep, (with `unique_keys`) a key given twice in one object, or (with
+/// `integers_fit`) a number written as an integer (no '.', no exponent) beyond 64 bits, which
+/// the parser would keep only as a double; as a phrase for a message ("nested more than 64
+/// levels deep", "the key \"a\" appears twice in one object", "the integer 1...0 does not fit
+/// in 64 bits"); "" when none. A syntax error ends the pass with "": the parse that follows
 /// reports it. Reads `in` to its end (or to the problem).
-std::string json_structure_problem(std::istream& in, int max_depth, bool unique_keys);
+std::string json_structure_problem(std::istream& in, int max_depth, bool unique_keys, bool integers_fit = false);
 
 }  // namespace vproxq

@@ -40,7 +40,8 @@ Json load_results(const fs::path& file) {
   }
   Json doc;
   // A results file is a few levels deep; comparing a far deeper document would recurse that
-  // deep. A key given twice in one object would compare only its last value.
+  // deep. A key given twice in one object would compare only its last value, and an integer
+  // beyond 64 bits would be compared as a double, not exactly.
   constexpr int kMaxDepth = 64;
   // Read whole first: the check and the parse both go through it, and a pipe (`vproxq diff
   // <(jq . a.json) b.json`) cannot be read twice.
@@ -48,7 +49,7 @@ Json load_results(const fs::path& file) {
   if (in.bad()) throw InputError("cannot read results file '" + file.string() + "': " + std::strerror(errno));
   {
     std::istringstream check(text);
-    const std::string problem = json_structure_problem(check, kMaxDepth, /*unique_keys=*/true);
+    const std::string problem = json_structure_problem(check, kMaxDepth, /*unique_keys=*/true, /*integers_fit=*/true);
     if (!problem.empty()) throw InputError("malformed results file '" + file.string() + "': " + problem);
   }
   try {

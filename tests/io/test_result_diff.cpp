@@ -281,8 +281,11 @@ TEST_F(DiffTest, MalformedFileThrowsInputErrorNamingIt) {
   const fs::path twice = save_text("twice.json", R"({"frames": [{"frame": 0, "x": 1, "x": 2}]})");
   const fs::path once = save_text("once.json", R"({"frames": [{"frame": 0, "x": 2}]})");
   const fs::path huge = save_text("huge.json", R"({"frames": [{"frame": 0, "x": 1e400}]})");
+  // Integers are compared exactly: one beyond 64 bits (parsed as a double) cannot be.
+  const fs::path wide = save_text("wide.json", R"({"frames": [{"frame": 0, "x": -9223372036854775809}]})");
   for (const auto& [file, phrase] : {std::pair{twice, "the key \"x\" appears twice in one object"},
-                                     std::pair{huge, "number overflow"}}) {
+                                     std::pair{huge, "number overflow"},
+                                     std::pair{wide, "the integer -9223372036854775809 does not fit in 64 bits"}}) {
     try {
       diff_result_files(file, once, {});
       ADD_FAILURE() << "expected InputError for " << file;
