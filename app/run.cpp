@@ -25,6 +25,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <thread>
 
 namespace vproxq {
 namespace {
@@ -247,10 +248,15 @@ void run(const Config& config) {
   info.device = voronoi.backend ? voronoi.backend->device() : "";
   info.grid = voronoi.backend ? grid : 0;
 
-  // Each frame's results are written on a background thread while the next frame is computed.
+  // Where --threads leaves a core free, frames are read ahead and written behind on background
+  // threads, while a frame is computed; else in line: with every core computing, the overlap
+  // took as long in all and made each query's time longer (report scenes, 2 threads on 2 cores:
+  // funnel's query 137 -> 148 ms per frame, breaking's 25 -> 28).
+  const unsigned cores = std::thread::hardware_concurrency();
+  const double inline_ms = cores > 0 && static_cast<unsigned>(info.threads) < cores ? kInlineMs : kInfinity;
   std::unique_ptr<BackgroundWriter> writer;
   if (!config.output_dir.empty())
-    writer = std::make_unique<BackgroundWriter>(std::make_unique<ResultWriter>(config.output_dir, info));
+    writer = std::make_unique<BackgroundWriter>(std::make_unique<ResultWriter>(config.output_dir, info), inline_ms);
 
   const bool want_distance = std::find(queries.begin(), queries.end(), "distance") != queries.end();
   const bool want_pd = std::find(queries.begin(), queries.end(), "pd") != queries.end();
@@ -258,10 +264,10 @@ void run(const Config& config) {
   // CCD of frame k covers the step k -> k+1 whenever the scene has frame k+1 (also past the
   // end of --frames); that frame is loaded once and reused as the next frame of the loop.
   // Frames are read in order, each on a background thread while the one before it is in use
-  // (in line when reads are quick; `load` is the time the loop waited for them): frames
-  // first .. last-1, and frame last too with CCD when the scene has it.
+  // (see above; in line when reads are quick; `load` is the time the loop waited for them):
+  // frames first .. last-1, and frame last too with CCD when the scene has it.
   const long read_end = want_ccd ? std::min(last + 1, count) : last;
-  FrameReadAhead reader(scene, static_cast<std::size_t>(first), static_cast<std::size_t>(read_end));
+  FrameReadAhead reader(scene, static_cast<std::size_t>(first), static_cast<std::size_t>(read_end), inline_ms);
   std::optional<Frame> next_frame;
   StaticIntraCache static_intra;
   Progress progress(info.frame_count, !config.quiet);

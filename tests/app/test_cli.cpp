@@ -212,10 +212,11 @@ TEST(Cli, InputErrorsNameTheFileAndLeaveNoOutput) {
   }
 }
 
-// Frames are read one ahead on a background thread (those that take over 1 ms to read: the
-// frames here hold two sheets of 12,800 triangles): a bad frame still fails the run only when
-// the run needs it (frame 2 below: not for --frames 0:2, but for CCD's step 1 -> 2), with the
-// same message and exit code and no output, whichever frames were computed before.
+// Frames are read one ahead on a background thread (with --threads below the core count, for
+// frames that take over 1 ms to read: the frames here hold two sheets of 12,800 triangles): a
+// bad frame still fails the run only when the run needs it (frame 2 below: not for
+// --frames 0:2, but for CCD's step 1 -> 2), with the same message and exit code and no output,
+// whichever frames were computed before; in line (all threads) alike.
 TEST(Cli, ABadFrameFailsOnlyARunThatNeedsIt) {
   constexpr int kSide = 81;  // vertices per side of each sheet
   std::string good;
@@ -237,17 +238,20 @@ TEST(Cli, ABadFrameFailsOnlyARunThatNeedsIt) {
     dir.write("frame_" + std::to_string(k) + ".obj", k == 2 ? good + "v 0 0 zero\n" : good);
   const auto scene = dir.write("scene.json", R"({"frames": {"pattern": "frame_%d.obj", "first": 0, "count": 4}})");
   const auto out = dir / "out";
-  auto r = vproxq(quote(scene) + " --frames 0:2 -o " + quote(out) + " --quiet");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_EQ(read_json(out / "results.json")["frames"].size(), 2u);
-  fs::remove_all(out);
-  for (const std::string& args : {std::string(" --frames 0:2 --queries distance,ccd"), std::string(""),
-                                  std::string(" --frames 1: --voronoi=cpu --queries distance,ccd,pd")}) {
-    SCOPED_TRACE(args);
-    r = vproxq(quote(scene) + args + " -o " + quote(out) + " --quiet");
-    EXPECT_EQ(r.exit_code, 3) << r.output;
-    EXPECT_NE(r.output.find("frame_2.obj"), std::string::npos) << r.output;
-    EXPECT_FALSE(fs::exists(out)) << r.output;
+  for (const std::string threads : {" --threads 1", ""}) {
+    SCOPED_TRACE(threads);
+    auto r = vproxq(quote(scene) + threads + " --frames 0:2 -o " + quote(out) + " --quiet");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(read_json(out / "results.json")["frames"].size(), 2u);
+    fs::remove_all(out);
+    for (const std::string& args : {std::string(" --frames 0:2 --queries distance,ccd"), std::string(""),
+                                    std::string(" --frames 1: --voronoi=cpu --queries distance,ccd,pd")}) {
+      SCOPED_TRACE(args);
+      r = vproxq(quote(scene) + threads + args + " -o " + quote(out) + " --quiet");
+      EXPECT_EQ(r.exit_code, 3) << r.output;
+      EXPECT_NE(r.output.find("frame_2.obj"), std::string::npos) << r.output;
+      EXPECT_FALSE(fs::exists(out)) << r.output;
+    }
   }
 }
 
