@@ -1,8 +1,7 @@
 #include "io/scene_source.hpp"
 
-#include "io/json_check.hpp"
-
 #include "core/errors.hpp"
+#include "io/json_check.hpp"
 #include "io/mesh_reader.hpp"
 #include "io/mesh_reader_detail.hpp"
 #include "io/read_util.hpp"
@@ -15,7 +14,6 @@
 #include <cstdio>
 #include <iterator>
 #include <mutex>
-#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string_view>
