@@ -7,8 +7,6 @@
 
 namespace vproxq {
 
-SerialWorker::SerialWorker() : thread_([this] { run(); }) {}
-
 void SerialWorker::run() {
   // Its own stack for the fatal-signal handler, as the pool threads have.
   const detail::AlternateSignalStack signal_stack;
@@ -30,7 +28,7 @@ SerialWorker::~SerialWorker() {
     stop_ = true;
   }
   wake_.notify_one();
-  thread_.join();
+  if (thread_.joinable()) thread_.join();
 }
 
 namespace {

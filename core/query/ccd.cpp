@@ -817,10 +817,10 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
   //   Stage II culls inter-object pairs only. Within one object it ruled out almost nothing
   // while most of the triangles it voxelized were there for such pairs alone: on the report
   // scenes' steps 10-18 (2 threads, sums over the 9 steps) it culled 0-66 of 1,279-103,966
-  // pairs within objects (against 0-43 of 543-25,498 between objects), and leaving those pairs
-  // out takes the voxelized triangles from 6,898 to 5,439 (skirt), 17,308 to 762 (cloth-ball),
-  // 5,959 to 798 (bowl), 76,249 to 10,499 (funnel) and 10,566 to 10,088 (breaking). README,
-  // "Continuous collision detection", has the times.
+  // pairs within objects (between objects it rules out 0-34 there), and leaving those pairs
+  // out takes the voxelized triangles per step from 713 to 572 (skirt), 1,797 to 76
+  // (cloth-ball), 634 to 89 (bowl), 7,419 to 975 (funnel) and 1,108 to 1,058 (breaking).
+  // README, "Continuous collision detection", has the times.
   const CcdVoxelCulling* voxels = opts.voxels;
   const bool stage2 = voxels || opts.voxel_backend;
   struct Candidate {
