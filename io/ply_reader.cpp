@@ -208,6 +208,14 @@ class BinaryCursor {
 
   std::size_t remaining() const { return static_cast<std::size_t>(end_ - p_); }
 
+  /// Throws unless every byte was read: bytes past the header's counts mean the counts or the
+  /// types do not describe the file (as values past them do in ascii).
+  void expect_end() const {
+    if (p_ == end_) return;
+    throw_input_error(*where_.file, std::to_string(remaining()) + " byte" + (remaining() == 1 ? "" : "s") +
+                                        " after the last element the header declares (do the header's "
+                                        "element counts and property types match the data?)");
+  }
 
   double real(PlyType t) {
     if (t == PlyType::Float32) return static_cast<double>(get<float>());
@@ -520,6 +528,7 @@ MeshGroup read_ply(const fs::path& file) {
   } else {
     BinaryCursor in(bytes, h.data_offset, h.format == Format::BinaryLittleEndian, where);
     read_body(file, h, in, where, out);
+    in.expect_end();
   }
   return out;
 }

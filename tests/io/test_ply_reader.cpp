@@ -317,6 +317,24 @@ TEST(PlyReaderErrors, AsciiDataProblems) {
   EXPECT_EQ(read_mesh_file(space)[0].faces.size(), 1u);
 }
 
+// Binary data past the header's counts: as in ascii, the counts (or the property types) do not
+// describe the file, so it is not read as if they did.
+TEST(PlyReaderErrors, BinaryBytesAfterTheLastElement) {
+  TempDir dir;
+  for (bool big : {false, true}) {
+    const std::string exact = binary_square<double>(big, "double");
+    EXPECT_EQ(read_mesh_file(dir.write("exact.ply", exact))[0].faces.size(), 3u);
+    const auto one = dir.write("one.ply", exact + "\n");
+    EXPECT_INPUT_ERROR(read_mesh_file(one), one.string() + ": 1 byte after the last element the header declares");
+    // A third face record that the header does not count.
+    std::string face = exact;
+    put<std::uint8_t>(face, 3, big);
+    for (int i : {0, 1, 2}) put<std::int32_t>(face, i, big);
+    const auto more = dir.write("more.ply", face);
+    EXPECT_INPUT_ERROR(read_mesh_file(more), more.string() + ": 13 bytes after the last element");
+  }
+}
+
 TEST(PlyReaderErrors, IndicesOutOfRange) {
   TempDir dir;
   const auto big = dir.write(
