@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <cstdio>
 #include <cstring>
@@ -280,6 +281,12 @@ int cli_main(int argc, char** argv) {
     if (!frames.empty()) config.frames = parse_frame_range(frames);
     if (app.count("--queries") > 0) config.queries = parse_query_list(queries);
     g_out_of_memory_hint = config.voronoi == "off" ? "" : "; a coarser --grid or --ccd-grid (or --voronoi=off) needs less";
+    // With -o the results files are the run's product, and stdout and stderr carry only notes
+    // and progress: a reader that goes away (`vproxq SCENE -o OUT 2>&1 | head -3`) must not end
+    // the run half-way by SIGPIPE. Ignored, a write to the closed pipe fails and is dropped; the
+    // run writes its files and exits with its own code. Without -o the summary on stdout is the
+    // product, and SIGPIPE ends the run as it ends any filter (no files are written then).
+    if (!config.output_dir.empty()) std::signal(SIGPIPE, SIG_IGN);
     // Options that the chosen backend does not use: said once, so that a sweep over --grid
     // with the default --voronoi=off does not silently measure the same run again and again.
     if (!config.quiet && config.voronoi == "off" && config.grid > 0)

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cctype>
+#include <csignal>
 #include <fstream>
 
 #include <sys/wait.h>
@@ -255,8 +256,6 @@ TEST(Cli, ABadFrameFailsOnlyARunThatNeedsIt) {
   }
 }
 
-// A failed run removes the output directories it created (all of a nested -o path), and
-// leaves an existing directory and what was in it alone.
 // A run ended by SIGTERM or SIGHUP (a timeout, a closed terminal; SIGINT is handled the same
 // way, but a shell starts background jobs with it ignored) removes its temporary files and the
 // directories it created, then ends by that signal. The run is a slow one (a very fine grid on
@@ -309,6 +308,49 @@ TEST(Cli, StaleTemporariesOfDeadRunsAreRemoved) {
   for (const auto& f : kept) EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
 }
 
+/// Runs `command` through /bin/sh with stdout and stderr on a pipe whose reading end is
+/// already closed (a reader that went away) and SIGPIPE at its default action; returns the
+/// status as a shell reports it (128 + the signal for a run ended by one).
+int run_with_output_closed(const std::string& command) {
+  int fds[2];
+  if (::pipe(fds) != 0) return -1;
+  ::close(fds[0]);
+  const pid_t child = ::fork();
+  if (child == 0) {
+    ::signal(SIGPIPE, SIG_DFL);
+    ::dup2(fds[1], 1);
+    ::dup2(fds[1], 2);
+    ::close(fds[1]);
+    ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  ::close(fds[1]);
+  int status = 0;
+  if (child < 0 || ::waitpid(child, &status, 0) != child) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+// With -o, a reader of stdout and stderr that goes away (`vproxq SCENE -o OUT 2>&1 | head`)
+// does not end the run: it writes its files, with nothing left behind, and exits with its own
+// code. The runs print on stderr from the start (a note on an unused option) and at the end
+// ("wrote ..."). Without -o, the summary on stdout is the product, and SIGPIPE ends the run.
+TEST(Cli, ARunWithOutputOutlivesAClosedTerminalPipe) {
+  ScratchDir dir;
+  const std::string run = std::string(VPROXQ_BINARY) + " " + quote(kSamples / "two-cubes" / "scene.json");
+  const auto out = dir / "out";
+  EXPECT_EQ(run_with_output_closed(run + " --grid 64 -o " + quote(out)), 0);
+  ASSERT_TRUE(fs::exists(out / "results.json"));
+  EXPECT_EQ(read_json(out / "results.json")["frames"].size(), 3u);
+  for (const auto& e : fs::directory_iterator(out))
+    EXPECT_TRUE(e.path().filename() == "results.json" || e.path().filename() == "results.h5") << e.path();
+  // The run's own error code still comes back.
+  EXPECT_EQ(run_with_output_closed(run + " --frames 9 -o " + quote(dir / "none")), 2);
+  EXPECT_FALSE(fs::exists(dir / "none"));
+  EXPECT_EQ(run_with_output_closed(run), 128 + SIGPIPE);
+}
+
+// A failed run removes the output directories it created (all of a nested -o path), and
+// leaves an existing directory and what was in it alone.
 TEST(Cli, FailedRunRemovesTheDirectoriesItCreated) {
   ScratchDir dir;
   const auto scene = dir.write("scene.json", R"({"frames": {"files": ["bad.obj"]}})");
