@@ -27,9 +27,12 @@ namespace fs = std::filesystem;
 
 // ---- Cleanup on a fatal signal ---------------------------------------------------------
 //
-// A run stopped by SIGINT, SIGTERM or SIGHUP (Ctrl-C, timeout, a closed terminal), or ended by
-// a crash (SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT), would otherwise leave its temporary files
-// and the directories it created. The paths live in fixed slots that the handler reads with
+// A run stopped by SIGINT, SIGTERM or SIGHUP (Ctrl-C, timeout, a closed terminal), ended by a
+// crash (SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT), or by any other signal whose default action
+// ends the process (SIGQUIT, SIGXCPU from a CPU-time limit, SIGALRM, SIGUSR1, ..., the
+// real-time signals), would otherwise leave its temporary files and the directories it created.
+// SIGXFSZ (a write past the file-size limit, `ulimit -f`) is ignored instead: the write then
+// fails with EFBIG and the run ends as for any failed write, with a message naming the file. The paths live in fixed slots that the handler reads with
 // async-signal-safe calls only (unlink, rmdir, signal, raise): files first, then directories,
 // newest first; then the signal is raised again with its default action, so the exit status
 // (and a core dump, where enabled) still says which signal ended the run. The handler runs on
@@ -62,15 +65,25 @@ void install_cleanup_handlers() {
     ss.ss_sp = alternate_stack;
     ss.ss_size = sizeof alternate_stack;
     const bool on_stack = ::sigaltstack(&ss, nullptr) == 0;
-    for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) {
+    auto at_default = [](int sig) {
       struct sigaction old {};
-      if (::sigaction(sig, nullptr, &old) != 0 || old.sa_handler != SIG_DFL) continue;
+      return ::sigaction(sig, nullptr, &old) == 0 && !(old.sa_flags & SA_SIGINFO) && old.sa_handler == SIG_DFL;
+    };
+    auto handle = [&](int sig) {
+      if (!at_default(sig)) return;
       struct sigaction act {};
       act.sa_handler = remove_partial_output;
       act.sa_flags = on_stack ? SA_ONSTACK : 0;
       sigemptyset(&act.sa_mask);
       ::sigaction(sig, &act, nullptr);
-    }
+    };
+    // The signals whose default action ends the process, but SIGKILL and SIGSTOP (they cannot
+    // be caught), SIGPIPE (app/cli.cpp decides) and SIGXFSZ (below).
+    for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGQUIT, SIGTRAP, SIGSYS,
+                    SIGXCPU, SIGALRM, SIGVTALRM, SIGPROF, SIGUSR1, SIGUSR2, SIGIO, SIGPWR, SIGSTKFLT})
+      handle(sig);
+    for (int sig = SIGRTMIN; sig <= SIGRTMAX; ++sig) handle(sig);
+    if (at_default(SIGXFSZ)) std::signal(SIGXFSZ, SIG_IGN);
     return true;
   }();
   (void)installed;

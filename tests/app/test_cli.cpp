@@ -260,9 +260,12 @@ TEST(Cli, ABadFrameFailsOnlyARunThatNeedsIt) {
 // way, but a shell starts background jobs with it ignored) removes its temporary files and the
 // directories it created, then ends by that signal. The run is a slow one (a very fine grid on
 // one thread), signalled once its temporary files exist.
-// A crash (SIGSEGV, SIGABRT, ...) is cleaned up the same way; those are sent here with kill.
+// A crash (SIGSEGV, SIGABRT, ...) is cleaned up the same way; those are sent here with kill. So
+// are the other signals that end a process by default: a CPU-time limit (SIGXCPU), SIGALRM,
+// SIGUSR1 (SIGQUIT too, but a shell starts background jobs with it ignored, as SIGINT).
 TEST(Cli, ARunEndedByASignalLeavesNothingBehind) {
-  for (const auto& [sig, number] : {std::pair<const char*, int>{"TERM", 15}, {"HUP", 1}, {"SEGV", 11}, {"ABRT", 6}}) {
+  for (const auto& [sig, number] : {std::pair<const char*, int>{"TERM", 15}, {"HUP", 1}, {"SEGV", 11}, {"ABRT", 6},
+                                    {"XCPU", 24}, {"ALRM", 14}, {"USR1", 10}}) {
     SCOPED_TRACE(sig);
     ScratchDir dir;
     const auto out = dir / "a" / "out";
@@ -274,6 +277,23 @@ TEST(Cli, ARunEndedByASignalLeavesNothingBehind) {
     EXPECT_NE(r.output.find("status " + std::to_string(128 + number)), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(dir / "a")) << r.output;
   }
+}
+
+// A write past the file-size limit (`ulimit -f`) would end the run by SIGXFSZ, leaving its
+// temporary files; it fails instead, as any failed write does: the runtime-error exit code, a
+// message naming the file and the problem, and nothing left behind.
+TEST(Cli, AWritePastTheFileSizeLimitIsAnErrorThatLeavesNothingBehind) {
+  ScratchDir dir;
+  const auto out = dir / "a" / "out";
+  // 8 blocks (4 KiB with dash's 512-byte blocks, 8 KiB with bash's 1024): below the size of
+  // this scene's results.h5 either way (over 30 KiB).
+  const auto r = test::run_command("ulimit -c 0; ulimit -f 8; " + std::string(VPROXQ_BINARY) + " " +
+                                   quote(kSamples / "skirt-tiny" / "scene.json") + " --quiet -o " + quote(out) +
+                                   " 2>&1; echo \"status $?\"");
+  EXPECT_NE(r.output.find("status 4"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("File too large"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find((out / ".results.").string()), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "a")) << r.output;
 }
 
 // A run killed without a chance to clean up (SIGKILL, the out-of-memory killer) leaves its
