@@ -6,6 +6,8 @@
 
 #include "core/broad_phase/object_broad_phase.hpp"
 #include "core/geometry/ccd.hpp"
+#include "core/geometry/point_triangle.hpp"
+#include "core/geometry/segment_segment.hpp"
 #include "support/random_scene.hpp"
 
 #include <Eigen/Geometry>
@@ -401,6 +403,72 @@ TEST(CcdKernel, RandomCollidingQueries) {
     ASSERT_TRUE(found_by(vf ? vertex_face_ccd(s, e) : edge_edge_ccd(s, e), ts, limit_hits)) << "query " << q;
   }
   std::printf("[          ] random colliding queries: 2000, box-limit hits: %d\n", limit_hits);
+}
+
+// A hit certifies that the primitives come within δ_k on every axis at the reported TOI (the
+// whole box within δ, or one point of its earliest face: ccd.cpp), so their distance at the TOI
+// is at most sqrt(3) max δ_k. The pipeline's culling margins rely on this (a pair apart by more
+// is never reported). Queries built to touch at a random time, and near misses: the same
+// contact at t = 0, held apart by 0.2 to 3 δ along the normal there while all four points move
+// by one common motion (so the distance stays that gap throughout).
+TEST(CcdKernel, AReportedToiIsATimeWhenThePrimitivesAreWithinTolerance) {
+  test::Rng rng(5150);
+  auto rnd = [&] { return Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)); };
+  int reported = 0, near_misses = 0, near_misses_reported = 0;
+  for (int q = 0; q < 4000; ++q) {
+    const bool vf = q % 2 == 0;
+    const bool near_miss = q % 4 >= 2;
+    const double ts = near_miss || q % 10 == 0 ? 0.0 : rng.uniform(0, 1);
+    P4 s{rnd(), rnd(), rnd(), rnd()}, e{rnd(), rnd(), rnd(), rnd()};
+    if (near_miss) {
+      const Vec3 motion = rnd();
+      for (size_t i = 0; i < 4; ++i) e[i] = s[i] + motion;
+    }
+    double u = rng.uniform(0.05, 0.95), v = rng.uniform(0.05, 0.95);
+    if (vf && u + v > 0.95) {
+      u = 0.95 - u;
+      v = 0.95 - v;
+    }
+    auto at = [&](int i, double t) {
+      return Vec3(s[static_cast<size_t>(i)] + t * (e[static_cast<size_t>(i)] - s[static_cast<size_t>(i)]));
+    };
+    const Vec3 target = vf ? Vec3(at(1, ts) + u * (at(2, ts) - at(1, ts)) + v * (at(3, ts) - at(1, ts)))
+                           : Vec3(at(2, ts) + v * (at(3, ts) - at(2, ts)));
+    Vec3 shift = vf ? Vec3(target - at(0, ts)) : Vec3(target - (at(0, ts) + u * (at(1, ts) - at(0, ts))));
+    double gap = 0;
+    if (near_miss) {
+      const Vec3 n = vf ? Vec3((at(2, 0) - at(1, 0)).cross(at(3, 0) - at(1, 0))) : Vec3((at(1, 0) - at(0, 0)).cross(at(3, 0) - at(2, 0)));
+      if (!(n.norm() > 1e-2)) continue;
+      gap = rng.uniform(0.2, 3) * 2e-6;  // δ is 1e-6 of an extent of about 2
+      shift += gap * n.normalized();
+      ++near_misses;
+    }
+    for (int i = 0; i < (vf ? 1 : 2); ++i) {
+      s[static_cast<size_t>(i)] += shift;
+      e[static_cast<size_t>(i)] += shift;
+    }
+    const CcdResult r = vf ? vertex_face_ccd(s, e) : edge_edge_ccd(s, e);
+    if (!near_miss) {
+      ASSERT_TRUE(r.collides) << "query " << q;
+    }
+    if (!r.collides || r.hit_limit) continue;
+    ++reported;
+    near_misses_reported += near_miss;
+    AABB box;
+    box.lo = box.hi = s[0];
+    double magnitude = 0;
+    for (const P4* p : {&s, &e})
+      for (const Vec3& x : *p) {
+        box.extend(x);
+        magnitude = std::max(magnitude, x.cwiseAbs().maxCoeff());
+      }
+    const double bound = std::sqrt(3.0) * ccd_max_tolerance((box.hi - box.lo).maxCoeff(), magnitude) * (1 + 1e-6);
+    const double t = r.toi;
+    const double d2 = vf ? point_triangle_distance(at(0, t), Triangle{at(1, t), at(2, t), at(3, t)}).squared_distance
+                         : segment_segment_distance(at(0, t), at(1, t), at(2, t), at(3, t)).squared_distance;
+    ASSERT_LE(std::sqrt(d2), bound) << "query " << q << (vf ? " vf" : " ee") << ", gap " << gap << ", toi " << t;
+  }
+  std::printf("[          ] reported: %d (near misses: %d of %d)\n", reported, near_misses_reported, near_misses);
 }
 
 // Random queries kept apart: the vertex / edge b stay above z = 0.1 while the triangle / edge a
