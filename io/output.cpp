@@ -17,6 +17,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 namespace vproxq {
@@ -252,6 +253,35 @@ fs::path prepare_dir(const fs::path& out_dir, CreatedDirs& created) {
   return out_dir;
 }
 
+/// One run at a time per output directory: two runs into the same `OUT` would each rename
+/// their results.h5 and results.json into place, and could leave one run's JSON beside the
+/// other's HDF5. The lock is flock(2) on the directory itself (no lock file to leave behind);
+/// the system releases it when the process ends, however it ends (SIGKILL included). Where
+/// the file system cannot lock (some network file systems), runs go unlocked, as before.
+class DirLock {
+ public:
+  explicit DirLock(const fs::path& dir) : fd_(::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC)) {
+    if (fd_ < 0) return;
+    if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) return;
+    const int error = errno;
+    ::close(fd_);
+    fd_ = -1;
+    if (error == EWOULDBLOCK) {
+      throw RuntimeError("output directory '" + dir.string() +
+                         "' is in use by another vproxq run (their results would be mixed); wait for it to "
+                         "end or choose another -o");
+    }
+  }
+  ~DirLock() {
+    if (fd_ >= 0) ::close(fd_);  // releases the lock
+  }
+  DirLock(const DirLock&) = delete;
+  DirLock& operator=(const DirLock&) = delete;
+
+ private:
+  int fd_;
+};
+
 // Flushes a closed file's data to disk, so that a rename never exposes an incomplete file
 // after a crash.
 void sync_file(const fs::path& file) {
@@ -271,6 +301,7 @@ void sync_file(const fs::path& file) {
 struct ResultWriter::Impl {
   explicit Impl(const fs::path& out_dir, const RunInfo& info)
       : dir(prepare_dir(out_dir, created_dirs)),
+        lock(dir),
         json_temp(temp_name(dir, kJsonName)),
         h5_temp(temp_name(dir, kHdf5Name)),
         json(std::in_place, json_temp.path(), info),
@@ -278,6 +309,7 @@ struct ResultWriter::Impl {
 
   CreatedDirs created_dirs;  // first: destroyed after the temporaries are removed
   fs::path dir;
+  DirLock lock;  // taken before the temporaries exist, released after they are gone
   TempPath json_temp;
   TempPath h5_temp;
   std::optional<detail::JsonResultStream> json;

@@ -279,6 +279,31 @@ TEST(Cli, ARunEndedByASignalLeavesNothingBehind) {
   }
 }
 
+// Two runs into one output directory at the same time could leave one run's results.json
+// beside the other's results.h5: the second fails at once (runtime error, naming the
+// directory) and leaves the first's files alone; once the first has ended, the directory can
+// be used again.
+TEST(Cli, ASecondRunIntoAnOutputDirectoryInUseFails) {
+  ScratchDir dir;
+  const auto out = dir / "a" / "out";
+  const std::string first = std::string(VPROXQ_BINARY) + " " + quote(kSamples / "skirt-tiny" / "scene.json") +
+                            " --voronoi=cpu --grid 4096 --threads 1 --quiet -o " + quote(out);
+  const std::string second =
+      std::string(VPROXQ_BINARY) + " " + quote(kSamples / "two-cubes" / "scene.json") + " --quiet -o " + quote(out);
+  const auto r = test::run_command(first + " & pid=$!; for i in $(seq 600); do ls " + quote(out) +
+                                   "/.results.json.tmp-* >/dev/null 2>&1 && break; sleep 0.05; done; " + second +
+                                   " 2>&1; echo \"second $?\"; ls -a " + quote(out) + "; kill -TERM $pid; wait $pid; echo \"first $?\"");
+  EXPECT_NE(r.output.find("second 4"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("'" + out.string() + "' is in use by another vproxq run"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(".results.json.tmp-"), std::string::npos) << r.output;  // the first's, left alone
+  EXPECT_EQ(r.output.find("results.json\n"), std::string::npos) << r.output;    // nothing committed
+  EXPECT_NE(r.output.find("first 143"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "a")) << r.output;
+  const auto again = vproxq(quote(kSamples / "two-cubes" / "scene.json") + " --frames 0:1 --quiet -o " + quote(out));
+  EXPECT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_TRUE(fs::exists(out / "results.json"));
+}
+
 // A write past the file-size limit (`ulimit -f`) would end the run by SIGXFSZ, leaving its
 // temporary files; it fails instead, as any failed write does: the runtime-error exit code, a
 // message naming the file and the problem, and nothing left behind.
