@@ -16,7 +16,8 @@
 // coordinate range can, long before the boxes are tiny; after a few boxes, so do directions
 // that move linearly with t (primitives that stay close and parallel while they turn: ccd.cpp).
 // Boxes are bisected depth first,
-// earlier t first (of a split in u or v, the half whose earliest face lies nearer 0 first); a
+// earlier t first (of a split in u or v, the half whose earliest face lies nearer 0 first),
+// after their start has been advanced past any earliest part a direction shows apart; a
 // box whose whole widened range lies within the tolerance cube [-δ, δ]^3, or one point of
 // whose earliest face is certified within it, is a hit, and the reported TOI is the smallest
 // lower t of the hits (boxes that start later than the best hit so far are dropped
