@@ -30,17 +30,17 @@ namespace fs = std::filesystem;
 //
 // A run stopped by SIGINT, SIGTERM or SIGHUP (Ctrl-C, timeout, a closed terminal), ended by a
 // crash (SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT), or by any other signal whose default action
-// ends the process (SIGQUIT, SIGXCPU from a CPU-time limit, SIGALRM, SIGUSR1, ..., the
-// real-time signals), would otherwise leave its temporary files and the directories it created.
-// SIGXFSZ (a write past the file-size limit, `ulimit -f`) is ignored instead: the write then
-// fails with EFBIG and the run ends as for any failed write, with a message naming the file. The paths live in fixed slots that the handler reads with
-// async-signal-safe calls only (unlink, rmdir, signal, raise): files first, then directories,
-// newest first; then the signal is raised again with its default action, so the exit status
-// (and a core dump, where enabled) still says which signal ended the run. The handler runs on
-// its own stack, so that a stack overflow still reaches it (this one for the main thread; the
-// pool threads of core/parallel.hpp set up their own). What no handler sees (SIGKILL, as
-// from the out-of-memory killer) is cleaned up by the next run into the same directory:
-// remove_stale_temporaries().
+// ends the process (SIGQUIT, SIGXCPU from a CPU-time limit, SIGALRM, SIGUSR1, ..., the real-time
+// signals), would otherwise leave its temporary files and the directories it created. SIGXFSZ (a
+// write past the file-size limit, `ulimit -f`) is ignored instead: the write then fails with
+// EFBIG and the run ends as for any failed write, with a message naming the file. The paths live
+// in fixed slots that the handler reads with async-signal-safe calls only (unlink, rmdir,
+// signal, raise): files first, then directories, newest first; then the signal is raised again
+// with its default action, so the exit status (and a core dump, where enabled) still says which
+// signal ended the run. The handler runs on its own stack, so that a stack overflow still
+// reaches it (this one for the main thread; the pool threads of core/parallel.hpp set up their
+// own). What no handler sees (SIGKILL, as from the out-of-memory killer) is cleaned up by the
+// next run into the same directory: remove_stale_temporaries().
 constexpr int kCleanupSlots = 16;
 constexpr std::size_t kCleanupPathMax = 4096;
 struct CleanupSlot {

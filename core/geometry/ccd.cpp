@@ -127,11 +127,16 @@ inline double unit_max(double w[3]) {
   return m;
 }
 
-/// Whether w (scaled by unit_max) separates every corner of F from 0 (see above).
-inline bool excludes(const double w[3], const double F[8][3], const double eps[3], const double fmax[3]) {
+/// E above: the bound on the error of fl(w . F̂_c) for w scaled by unit_max.
+inline double dot_rounding_bound(const double w[3], const double eps[3], const double fmax[3]) {
   double bound = 0;
   for (int k = 0; k < 3; ++k) bound += std::abs(w[k]) * (eps[k] + kDotRounding * fmax[k]);
-  bound = bound * (1 + 0x1p-40) + 0x1p-1070;
+  return bound * (1 + 0x1p-40) + 0x1p-1070;
+}
+
+/// Whether w (scaled by unit_max) separates every corner of F from 0 (see above).
+inline bool excludes(const double w[3], const double F[8][3], const double eps[3], const double fmax[3]) {
+  const double bound = dot_rounding_bound(w, eps, fmax);
   double lo = kInfinity, hi = -kInfinity;
   for (int c = 0; c < 8; ++c) {
     const double p = (w[0] * F[c][0] + w[1] * F[c][1]) + w[2] * F[c][2];
@@ -385,9 +390,7 @@ bool advance_start(const Query& q, Kind kind, Box& b, double x0[4][3], double F[
   double share = 0, chosen[3] = {0, 0, 0};
   for (int i = 0; i < 3; ++i) {
     if (!(unit_max(w[i]) > 0)) continue;
-    double bound = 0;
-    for (int k = 0; k < 3; ++k) bound += std::abs(w[i][k]) * (q.eps[k] + kDotRounding * fmax[k]);
-    const double margin = 2 * (bound * (1 + 0x1p-40) + 0x1p-1070);
+    const double margin = 2 * dot_rounding_bound(w[i], q.eps, fmax);
     double p0[4], p1[4];
     bool above = true, below = true;
     for (int c = 0; c < 4; ++c) {

@@ -410,7 +410,8 @@ TEST(CcdKernel, RandomCollidingQueries) {
 // is at most sqrt(3) max δ_k. The pipeline's culling margins rely on this (a pair apart by more
 // is never reported). Queries built to touch at a random time, and near misses: the same
 // contact at t = 0, held apart by 0.2 to 3 δ along the normal there while all four points move
-// by one common motion (so the distance stays that gap throughout).
+// by one common motion (so the distance stays that gap throughout; the directional test decides
+// these apart, so none is reported now, and any that were would have to meet the bound).
 TEST(CcdKernel, AReportedToiIsATimeWhenThePrimitivesAreWithinTolerance) {
   test::Rng rng(5150);
   auto rnd = [&] { return Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)); };
