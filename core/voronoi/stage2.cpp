@@ -235,7 +235,10 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
     // of near[i]: the answer does not depend on the triangle, so it is found once per voxel
     // (neighbouring triangles share most of their voxels) and remembered over the object's
     // range of cells (when that is not huge).
-    auto [clo, chi] = sg.cell_range(boxes.objects[i]);
+    // (Named, not a structured binding: C++17 lets no lambda capture one, and clang holds to that.)
+    const auto cell_range = sg.cell_range(boxes.objects[i]);
+    const StageGrid::Cell& clo = cell_range.first;
+    const StageGrid::Cell& chi = cell_range.second;
     std::array<std::int64_t, 3> span{};
     for (size_t a = 0; a < 3; ++a) span[a] = std::int64_t{chi[a]} - clo[a] + 1;
     const std::int64_t cells = span[0] * span[1] * span[2];
