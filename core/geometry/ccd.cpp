@@ -134,11 +134,12 @@ inline double dot_rounding_bound(const double w[3], const double eps[3], const d
   return bound * (1 + 0x1p-40) + 0x1p-1070;
 }
 
-/// Whether w (scaled by unit_max) separates every corner of F from 0 (see above).
-inline bool excludes(const double w[3], const double F[8][3], const double eps[3], const double fmax[3]) {
+/// Whether w (scaled by unit_max) separates every one of the n values F from 0 (see above;
+/// fmax bounds their |coordinates|).
+inline bool excludes(const double w[3], const double (*F)[3], int n, const double eps[3], const double fmax[3]) {
   const double bound = dot_rounding_bound(w, eps, fmax);
   double lo = kInfinity, hi = -kInfinity;
-  for (int c = 0; c < 8; ++c) {
+  for (int c = 0; c < n; ++c) {
     const double p = (w[0] * F[c][0] + w[1] * F[c][1]) + w[2] * F[c][2];
     lo = std::min(lo, p);
     hi = std::max(hi, p);
@@ -152,7 +153,7 @@ bool excluded_along_box_directions(const double F[8][3], const double eps[3], co
   for (int c = 0; c < 8; ++c)
     for (int k = 0; k < 3; ++k) w0[k] += F[c][k];
   if (!(unit_max(w0) > 0)) return false;
-  if (excludes(w0, F, eps, fmax)) return true;
+  if (excludes(w0, F, 8, eps, fmax)) return true;
   // Spreads: the sum over the 4 corner pairs that differ in one parameter of their change,
   // scaled to max |component| = 1; size[dim] is their max |component| before (0: none).
   double spread[3][3];
@@ -176,11 +177,80 @@ bool excluded_along_box_directions(const double F[8][3], const double eps[3], co
   const double* a = spread[first];
   const double along = (w0[0] * a[0] + w0[1] * a[1] + w0[2] * a[2]) / (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
   double w1[3] = {w0[0] - along * a[0], w0[1] - along * a[1], w0[2] - along * a[2]};
-  if (unit_max(w1) > 0 && excludes(w1, F, eps, fmax)) return true;
+  if (unit_max(w1) > 0 && excludes(w1, F, 8, eps, fmax)) return true;
   if (!(size[second] > 0)) return false;
   const double* b = spread[second];
   double w2[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-  return unit_max(w2) > 0 && excludes(w2, F, eps, fmax);
+  return unit_max(w2) > 0 && excludes(w2, F, 8, eps, fmax);
+}
+
+// ---- Vertex–face boxes across the hypotenuse u + v = 1 ------------------------------------
+//
+// A vertex–face box that reaches past u + v = 1 has corners outside the triangle, where F can
+// have roots that the triangle has not. For a degenerate triangle in line with the vertex (F
+// then keeps one direction: one equation, not three) F = 0 on a whole surface beyond the
+// hypotenuse, t (u + v) = const, and no box across it could be excluded until it was tiny in t,
+// u and v at once: on a fuzzed scene, a vertex meeting the end of such a triangle at t = 1
+// stopped at the 2^17-box limit and was reported at t = 0.4995. Only the box's part of the
+// triangle matters: for fixed t, F is affine in (u, v) jointly, and for fixed (u, v) affine in
+// t, so over [t0, t1] x (that part, a polygon of at most 5 vertices) F lies in the hull of its
+// values at t0 and at t1 at the polygon's vertices. Those on the hypotenuse are (1 - v, v) or
+// (u, 1 - u) with u, v sides of the box: multiples of 2^-50, so exact. F is evaluated there as
+// corner_values() evaluates a corner (within ε_k of the exact value: the derivation above holds
+// for any u, v in [0, 1]), and the coordinate ranges and the direction of their sum then
+// exclude the box on the same terms as its corners would.
+
+/// Boxes a vertex–face query evaluates before boxes across the hypotenuse are also judged by
+/// their part inside the triangle. Queries decided sooner (nearly all) keep the corner test's
+/// answer, which reports a vertex passing within δ just beyond the hypotenuse (tolerance allows
+/// it; CcdPipeline.NearMissesWithinTheKernelToleranceAreKept has the pipeline keep such pairs);
+/// the surface of roots beyond it is what takes the others to the box limit.
+constexpr std::uint32_t kWithinTriangleAfter = 128;
+
+/// Whether the part of vertex–face box b inside the triangle (b.u0 + b.v0 <= 1 < b.u1 + b.v1)
+/// holds no root, from the positions x0 at b.t0 and x1 at b.t1 (see above).
+bool excluded_within_triangle(const Query& q, const Box& b, const double x0[4][3], const double x1[4][3]) {
+  double uv[5][2];
+  int n = 0;
+  auto add = [&](double u, double v) {
+    uv[n][0] = u;
+    uv[n][1] = v;
+    ++n;
+  };
+  add(b.u0, b.v0);
+  if (b.u1 + b.v0 <= 1) {
+    add(b.u1, b.v0);
+    add(b.u1, 1 - b.u1);
+  } else {
+    add(1 - b.v0, b.v0);
+  }
+  if (b.u0 + b.v1 <= 1) {
+    add(1 - b.v1, b.v1);
+    add(b.u0, b.v1);
+  } else {
+    add(b.u0, 1 - b.u0);
+  }
+  double G[10][3], gmax[3] = {0, 0, 0}, sum[3] = {0, 0, 0};
+  for (int k = 0; k < 3; ++k) {
+    double lo = kInfinity, hi = -kInfinity;
+    for (int end = 0; end < 2; ++end) {
+      const double(*x)[3] = end ? x1 : x0;
+      // The same expressions as corner_values().
+      const double pa = x[0][k] - x[1][k];
+      const double ba = x[2][k] - x[1][k];
+      const double ca = x[3][k] - x[1][k];
+      for (int i = 0; i < n; ++i) {
+        const double f = (pa - uv[i][0] * ba) - uv[i][1] * ca;
+        G[end * n + i][k] = f;
+        lo = std::min(lo, f);
+        hi = std::max(hi, f);
+        sum[k] += f;
+      }
+    }
+    if (lo > q.eps[k] || hi < -q.eps[k]) return true;
+    gmax[k] = std::max(-lo, hi);
+  }
+  return unit_max(sum) > 0 && excludes(sum, G, 2 * n, q.eps, gmax);
 }
 
 // ---- Exclusion along a direction that moves with t -------------------------------------------
@@ -423,7 +493,7 @@ bool advance_start(const Query& q, Kind kind, Box& b, double x0[4][3], double F[
     for (int k = 0; k < 3; ++k) G[c][k] = F[c][k];
   for (int c = 0; c < 8; ++c)
     for (int k = 0; k < 3; ++k) gmax[k] = std::max(gmax[k], std::abs(G[c][k]));
-  if (!excludes(chosen, G, q.eps, gmax)) return false;
+  if (!excludes(chosen, G, 8, q.eps, gmax)) return false;
   b.t0 = ts;
   for (int c = 0; c < 8; c += 2)
     for (int k = 0; k < 3; ++k) F[c][k] = G[c | 1][k];
@@ -515,7 +585,9 @@ CcdResult solve(Kind kind, const std::array<Vec3, 4>& start, const std::array<Ve
         if (hi + q.eps[k] > q.delta[k] || lo - q.eps[k] < -q.delta[k]) inside = false;
         fmax[k] = std::max(-lo, hi);
       }
-      if (excluded || excluded_along_box_directions(F, q.eps, fmax)) {
+      if (excluded || excluded_along_box_directions(F, q.eps, fmax) ||
+          (kind == Kind::VertexFace && result.boxes > kWithinTriangleAfter && b.u1 + b.v1 > 1 &&
+           excluded_within_triangle(q, b, x0, x1))) {
         decided = true;
         break;
       }

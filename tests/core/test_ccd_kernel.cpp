@@ -218,6 +218,47 @@ TEST(CcdKernel, NearDegenerateQueriesAreDecidedWellBeforeTheBoxLimit) {
   EXPECT_LT(v.boxes, kFewBoxes);
 }
 
+// A vertex in line with a degenerate triangle (two corners at one point, the third apart):
+// F keeps one direction, so beyond the hypotenuse u + v = 1 it vanishes on a whole surface of
+// (t, u, v) that lies outside the triangle. Boxes across the hypotenuse must be judged by their
+// part inside it; judged by their corners, the contact at t = 1 below stopped at the box limit
+// and was reported at t = 0.4995 (found by fuzzing, tests/fuzz/fuzz_queries.cpp).
+TEST(CcdKernel, AVertexInLineWithADegenerateTriangleIsJudgedWithinTheTriangle) {
+  const Eigen::Matrix3d rot = Eigen::AngleAxisd(0.4, Vec3(3, -1, 2).normalized()).toRotationMatrix();
+  constexpr std::uint32_t kFewBoxes = 10000;
+  const Vec3 diag(1, 1, 1);
+  for (bool rotate : {false, true}) {
+    SCOPED_TRACE(rotate ? "rotated" : "on the diagonal");
+    auto frame = [&](P4 p) {
+      if (rotate)
+        for (Vec3& x : p) x = rot * x + Vec3(0.3, -0.2, 0.1);
+      return p;
+    };
+    // p and a fixed, b = c moving from a to p: the closed triangle reaches p at t = 1 only.
+    const Vec3 p = -8 * diag, a = 3.5 * diag;
+    const CcdResult end = vertex_face_ccd(frame(P4{p, a, a, a}), frame(P4{p, a, p, p}));
+    ASSERT_TRUE(end.collides);
+    EXPECT_LE(end.toi, 1.0);
+    EXPECT_GE(end.toi, 1.0 - kToiSlack);
+    EXPECT_FALSE(end.hit_limit);
+    EXPECT_LT(end.boxes, kFewBoxes);
+    // b = c stops 1e-3 of the way short of p (far beyond δ): no contact.
+    const Vec3 short_of_p = p + 1e-3 * (a - p);
+    const CcdResult miss = vertex_face_ccd(frame(P4{p, a, a, a}), frame(P4{p, a, short_of_p, short_of_p}));
+    EXPECT_FALSE(miss.collides);
+    EXPECT_FALSE(miss.hit_limit);
+    EXPECT_LT(miss.boxes, kFewBoxes);
+    // The vertex moving along the line onto the fixed segment [a, b]: contact at t = 0.5.
+    const Vec3 b = -2 * diag;
+    const CcdResult mid = vertex_face_ccd(frame(P4{-6 * diag, a, b, b}), frame(P4{2 * diag, a, b, b}));
+    ASSERT_TRUE(mid.collides);
+    EXPECT_LE(mid.toi, 0.5 + 1e-12);
+    EXPECT_GE(mid.toi, 0.5 - kToiSlack);
+    EXPECT_FALSE(mid.hit_limit);
+    EXPECT_LT(mid.boxes, kFewBoxes);
+  }
+}
+
 // The directional exclusion must never remove a root: random queries that touch at a chosen
 // time t* in the configurations it is meant for, all in a random rotated frame: coplanar
 // vertex–face motion (everything in one plane), coplanar crossing edges, and collinear edges
