@@ -2,10 +2,11 @@
 // objects of 3-8 vertices and 1-8 faces, coordinates mostly on a small integer grid times a
 // power of two, so that shared, coplanar, collinear and repeated vertices are common, plus a
 // few extreme values within the readers' range), and every query must equal its brute force
-// bitwise, without and with Stage II (CPU backends) at the decoded grid and thread count, as
-// in tests/core/test_varied_scenes.cpp. Penetration depth, which has no brute force, must
-// only not crash. CCD is compared only when no test stopped at the kernel's box limit (the
-// one documented way in which culling may differ from the brute force, core/query/ccd.hpp).
+// bitwise, with the suite's comparisons (support/expect_same.hpp), without and with Stage II
+// (CPU backends) at the decoded grid and thread count, as in
+// tests/core/test_varied_scenes.cpp. Penetration depth, which has no brute force, must only
+// not crash. CCD is compared only when no test stopped at the kernel's box limit (the one
+// documented way in which culling may differ from the brute force, core/query/ccd.hpp).
 #include "core/query/ccd.hpp"
 #include "core/query/inter_distance.hpp"
 #include "core/query/intersecting_pairs.hpp"
@@ -15,6 +16,8 @@
 #include "core/voronoi/self_stage2.hpp"
 #include "core/voronoi/stage2.hpp"
 #include "fuzz_support.hpp"
+#include "support/expect_same.hpp"
+#include "trap_on_test_failure.hpp"
 
 #include <cmath>
 #include <cstddef>
@@ -51,9 +54,14 @@ double coordinate(Reader& in, double unit) {
   }
 }
 
-bool same(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
-
 }  // namespace
+
+// The comparisons are the test suite's (support/expect_same.hpp); a failed one stops the
+// fuzzer, which records the input.
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  fuzz::trap_on_test_failure();
+  return 0;
+}
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   Reader in{data, size};
@@ -101,14 +109,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const VoronoiBounds vb = compute_voronoi_bounds(from, boxes, stage1, *inter_backends[threads - 1], grid, threads);
   for (const VoronoiBounds* v : {static_cast<const VoronoiBounds*>(nullptr), &vb}) {
     const auto got = inter_object_distance(from, boxes, stage1, InterDistanceOptions{threads, v});
-    VPROXQ_FUZZ_CHECK(got.per_object.size() == inter_ref.per_object.size());
-    for (std::size_t i = 0; i < got.per_object.size(); ++i) {
-      const auto& g = got.per_object[i];
-      const auto& r = inter_ref.per_object[i];
-      VPROXQ_FUZZ_CHECK(g.object == r.object && g.nearest_object == r.nearest_object && same(g.distance, r.distance));
-      VPROXQ_FUZZ_CHECK(g.triangles == r.triangles && g.points[0] == r.points[0] && g.points[1] == r.points[1]);
-      VPROXQ_FUZZ_CHECK(g.kind == r.kind);
-    }
+    test::expect_same_inter(got, inter_ref, v ? "inter cpu" : "inter off");
   }
 
   const auto intra_ref = intra_object_distance_brute_force(from);
@@ -116,20 +117,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const SelfVoronoiBounds sb = compute_self_voronoi_bounds(from, boxes, ring2, *self_backends[threads - 1], grid, threads);
   for (const SelfVoronoiBounds* v : {static_cast<const SelfVoronoiBounds*>(nullptr), &sb}) {
     const auto got = intra_object_distance(from, boxes, ring2, IntraDistanceOptions{threads, v});
-    VPROXQ_FUZZ_CHECK(got.per_object.size() == intra_ref.per_object.size());
-    for (std::size_t i = 0; i < got.per_object.size(); ++i) {
-      const auto& g = got.per_object[i];
-      const auto& r = intra_ref.per_object[i];
-      VPROXQ_FUZZ_CHECK(same(g.distance, r.distance) && g.triangles == r.triangles);
-      VPROXQ_FUZZ_CHECK(g.points[0] == r.points[0] && g.points[1] == r.points[1]);
-      VPROXQ_FUZZ_CHECK(g.per_triangle.size() == r.per_triangle.size());
-      for (std::size_t t = 0; t < r.per_triangle.size(); ++t) {
-        const auto& x = g.per_triangle[t];
-        const auto& y = r.per_triangle[t];
-        VPROXQ_FUZZ_CHECK(x.nearest == y.nearest && same(x.distance, y.distance) && x.kind == y.kind);
-        VPROXQ_FUZZ_CHECK(x.points[0] == y.points[0] && x.points[1] == y.points[1]);
-      }
-    }
+    test::expect_same_intra(got, intra_ref, v ? "intra cpu" : "intra off");
   }
 
   const auto pairs_ref = intersecting_pairs_brute_force(from);
@@ -150,21 +138,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (const CcdVoxelCulling* v : {static_cast<const CcdVoxelCulling*>(nullptr), &voxels}) {
     const CcdStepResult got = continuous_collisions(from, to, sweep, CcdOptions{threads, v});
     if (ref.counters.limit_hits > 0 || got.counters.limit_hits > 0) continue;
-    VPROXQ_FUZZ_CHECK(got.vf.size() == ref.vf.size() && got.ee.size() == ref.ee.size());
-    for (std::size_t k = 0; k < got.vf.size(); ++k) {
-      const auto &a = got.vf[k], &b = ref.vf[k];
-      VPROXQ_FUZZ_CHECK(a.object_v == b.object_v && a.vertex == b.vertex && a.object_f == b.object_f &&
-                        a.face == b.face && a.toi == b.toi);
-    }
-    for (std::size_t k = 0; k < got.ee.size(); ++k) {
-      const auto &a = got.ee[k], &b = ref.ee[k];
-      VPROXQ_FUZZ_CHECK(a.object_a == b.object_a && a.edge_a == b.edge_a && a.object_b == b.object_b &&
-                        a.edge_b == b.edge_b && a.toi == b.toi);
-    }
-    VPROXQ_FUZZ_CHECK(got.pairs.size() == ref.pairs.size());
-    for (std::size_t k = 0; k < got.pairs.size(); ++k)
-      VPROXQ_FUZZ_CHECK(got.pairs[k].objects == ref.pairs[k].objects && got.pairs[k].toi == ref.pairs[k].toi &&
-                        got.pairs[k].primitive_pairs == ref.pairs[k].primitive_pairs);
+    test::expect_same_ccd(got, ref);
   }
   return 0;
 }
