@@ -409,6 +409,16 @@ bool point_within_at_t0(const Query& q, const Box& b, const double x[4][3], cons
     return false;
   }
   if (!(u >= 0 && u <= 1 && v >= 0 && v <= 1)) return false;
+  if (q.kind == Kind::VertexFace && !(u + v < 1)) {
+    // Beyond the hypotenuse, or on it: the candidate moves back just inside it within the box
+    // (u first, then v). A contact on the triangle's edge bc (p in line with b and c, or at
+    // corner b or c) has its minimizer on u + v = 1 itself, and without this the box there
+    // could only become a hit once it lay within δ whole: a fuzzed query of a vertex sliding
+    // along bc in the triangle's plane, meeting corner c first, ran to the box limit.
+    const double below_one = 1 - 0x1p-52;
+    u = std::max(b.u0, std::min(u, below_one - v));
+    if (!(u + v < 1)) v = std::max(b.v0, below_one - u);
+  }
   // fl(u + v) < 1 implies u + v < 1 (rounding is monotone and 1 is a double).
   if (q.kind == Kind::VertexFace && !(u + v < 1)) return false;
   for (int k = 0; k < 3; ++k) {

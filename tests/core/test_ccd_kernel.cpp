@@ -259,6 +259,39 @@ TEST(CcdKernel, AVertexInLineWithADegenerateTriangleIsJudgedWithinTheTriangle) {
   }
 }
 
+// A vertex that slides along the triangle's edge bc, in the triangle's plane: the roots lie on
+// the hypotenuse u + v = 1 itself (F's component off the line bc is (p - a) (1 - u - v)), and
+// the first contact is at corner c or b. The earliest-face certificate must look just inside
+// the hypotenuse, not on it: from (u, v) = (0, 1) alone it certified nothing, and the first
+// query below (found by tests/fuzz/fuzz_ccd_kernel.cpp) stopped at the box limit. The triangle
+// grows from a point; b and c move along the line, a off it; everything is exact, so the
+// contact interval is exactly [0.5, 0.75] (c reaches p at 0.5, b at 0.75).
+TEST(CcdKernel, AVertexSlidingAlongAnEdgeMeetsItsCornerFirst) {
+  constexpr std::uint32_t kFewBoxes = 10000;
+  const Vec3 o(-8, 0, -8);
+  const P4 start{Vec3(-5, 0, -8), o, o, o};
+  const P4 end{Vec3(2, 0, -8), Vec3(-8, 0, 5), Vec3(3, 0, -8), Vec3(5, 0, -8)};
+  auto expect_contact_at = [&](const CcdResult& r, double toi) {
+    ASSERT_TRUE(r.collides);
+    EXPECT_LE(r.toi, toi);
+    EXPECT_GE(r.toi, toi - kToiSlack);
+    EXPECT_FALSE(r.hit_limit);
+    EXPECT_LT(r.boxes, kFewBoxes);
+  };
+  {
+    SCOPED_TRACE("meets c first");
+    expect_contact_at(vertex_face_ccd(start, end), 0.5);
+  }
+  {
+    SCOPED_TRACE("time reversed: meets b first");
+    expect_contact_at(vertex_face_ccd(end, start), 0.25);
+  }
+  {
+    SCOPED_TRACE("b and c swapped");
+    expect_contact_at(vertex_face_ccd(P4{start[0], start[1], start[3], start[2]}, P4{end[0], end[1], end[3], end[2]}), 0.5);
+  }
+}
+
 // The directional exclusion must never remove a root: random queries that touch at a chosen
 // time t* in the configurations it is meant for, all in a random rotated frame: coplanar
 // vertex–face motion (everything in one plane), coplanar crossing edges, and collinear edges
