@@ -290,8 +290,11 @@ char glyph_char(int glyph) { return "siggraph06"[glyph % kGlyphCount]; }
 
 Mesh glyph_mesh(int glyph, int around, int along, double scale, double half_width,
                 double half_depth) {
+  // The stroke first: it sets `closed`, and the order in which a call's arguments are
+  // evaluated is unspecified (GCC read `closed` before the stroke set it, clang after).
   bool closed = false;
-  const std::vector<P2> centre = resample(glyph_stroke(glyph, closed), along, closed);
+  const std::vector<P2> stroke = glyph_stroke(glyph, closed);
+  const std::vector<P2> centre = resample(stroke, along, closed);
   Mesh m;
   for (int k = 0; k < along; ++k) {
     const int prev = closed ? (k + along - 1) % along : std::max(0, k - 1);

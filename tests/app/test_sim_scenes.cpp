@@ -113,11 +113,12 @@ TEST(SimScenes, FullSizeDefaultsMatchThePapersTriangleCounts) {
     const auto [objects, triangles] = moving_objects(frame);
     EXPECT_EQ(objects, c.objects);
     EXPECT_EQ(triangles, c.triangles);
-    for (const auto& [name, tris] : c.object_triangles) {
+    for (const auto& named : c.object_triangles) {
+      const std::string& name = named.first;
       const auto it = std::find_if(frame.objects.begin(), frame.objects.end(),
                                    [&](const Object& o) { return o.name == name; });
       ASSERT_NE(it, frame.objects.end()) << name;
-      EXPECT_EQ(it->num_triangles(), tris) << name;
+      EXPECT_EQ(it->num_triangles(), named.second) << name;
     }
   }
 }
