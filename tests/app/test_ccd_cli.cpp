@@ -31,9 +31,8 @@ using test::write_obj;
 Frame moved(const Frame& prev, test::Rng& rng, double drift, double jitter) {
   Frame f = prev;
   for (Object& o : f.objects) {
-    const Vec3 d(rng.uniform(-drift, drift), rng.uniform(-drift, drift), rng.uniform(-drift, drift));
-    for (Vec3& p : o.positions)
-      p += d + Vec3(rng.uniform(-jitter, jitter), rng.uniform(-jitter, jitter), rng.uniform(-jitter, jitter));
+    const Vec3 d = rng.vec3(-drift, drift);
+    for (Vec3& p : o.positions) p += d + rng.vec3(-jitter, jitter);
   }
   return f;
 }
@@ -113,7 +112,11 @@ void expect_equal_brute_force(const fs::path& scene_path, const fs::path& out, s
 
 TEST(CcdCli, BackendsGiveIdenticalResultsEqualToBruteForce) {
   std::uint64_t found = 0;
-  for (std::uint64_t seed : {3u, 8u}) {
+  // Elementary tests with and without Stage II, summed over the seeds: Stage II culls only
+  // candidate pairs whose swept triangles share no voxel, and about half of these small scenes
+  // have none (seed 3: 228 tests either way); seeds 5 and 8 have some (220 of 225, 796 of 798).
+  std::uint64_t all_tests_off = 0, all_tests_cpu = 0;
+  for (std::uint64_t seed : {5u, 8u}) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     ScratchDir dir;
     const fs::path scene = write_scene(dir, seed, 4, 3);
@@ -129,7 +132,7 @@ TEST(CcdCli, BackendsGiveIdenticalResultsEqualToBruteForce) {
       EXPECT_EQ(r.exit_code, 0) << backend << ": " << r.output;
     }
     // The GL Stage II does integer work only: the same culling as the CPU's, counter for
-    // counter, and it must cull something.
+    // counter, and over the seeds it must cull something.
     const auto off = read_json(dir / "off" / "results.json");
     const auto cpu = read_json(dir / "cpu" / "results.json");
     const auto gpu = read_json(dir / "gpu" / "results.json");
@@ -153,8 +156,11 @@ TEST(CcdCli, BackendsGiveIdenticalResultsEqualToBruteForce) {
       tests_cpu += c["elementary_tests"].get<std::uint64_t>();
       tests_off += off["frames"][f]["stats"]["ccd"]["elementary_tests"].get<std::uint64_t>();
     }
-    EXPECT_LT(tests_cpu, tests_off);
+    EXPECT_LE(tests_cpu, tests_off);
+    all_tests_cpu += tests_cpu;
+    all_tests_off += tests_off;
   }
+  EXPECT_LT(all_tests_cpu, all_tests_off) << "Stage II must cull some elementary tests in these scenes";
   EXPECT_GT(found, 0u) << "the scenes must have collisions for the comparison to mean much";
 }
 

@@ -304,7 +304,7 @@ TEST(CcdKernel, RandomDegenerateCollidingQueries) {
     const int kind = q % 3;  // 0: coplanar vertex-face, 1: coplanar edges, 2: collinear edges
     const double ts = q % 10 == 0 ? 0.0 : q % 10 == 1 ? 1.0 : rng.uniform(0, 1);
     // Points in the plane z = 0 (kind 0, 1) or on the x axis (kind 2).
-    auto rnd = [&] { return Vec3(rng.uniform(-1, 1), kind == 2 ? 0.0 : rng.uniform(-1, 1), 0.0); };
+    auto rnd = [&] { return Vec3{rng.uniform(-1, 1), kind == 2 ? 0.0 : rng.uniform(-1, 1), 0.0}; };
     P4 s{rnd(), rnd(), rnd(), rnd()}, e{rnd(), rnd(), rnd(), rnd()};
     auto at = [&](int i) { return Vec3(s[static_cast<size_t>(i)] + ts * (e[static_cast<size_t>(i)] - s[static_cast<size_t>(i)])); };
     double u = rng.uniform(0, 1), v = rng.uniform(0, 1);
@@ -323,8 +323,7 @@ TEST(CcdKernel, RandomDegenerateCollidingQueries) {
       e[static_cast<size_t>(i)] += shift;
     }
     const Eigen::Matrix3d rot =
-        Eigen::AngleAxisd(rng.uniform(0, 3), Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)).normalized())
-            .toRotationMatrix();
+        Eigen::AngleAxisd{rng.uniform(0, 3), rng.vec3(-1, 1).normalized()}.toRotationMatrix();
     for (P4* p : {&s, &e})
       for (Vec3& x : *p) x = rot * x;
     ASSERT_TRUE(found_by(kind == 0 ? vertex_face_ccd(s, e) : edge_edge_ccd(s, e), ts, limit_hits))
@@ -372,8 +371,7 @@ RollPair roll_pair(test::Rng& rng, bool vf, double gap_over_edge) {
     }
   }
   const Eigen::Matrix3d rot =
-      Eigen::AngleAxisd(rng.uniform(0, 3), Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)).normalized())
-          .toRotationMatrix();
+      Eigen::AngleAxisd{rng.uniform(0, 3), rng.vec3(-1, 1).normalized()}.toRotationMatrix();
   for (P4* x : {&p.start, &p.end})
     for (Vec3& y : *x) y = rot * y;
   return p;
@@ -446,7 +444,7 @@ TEST(CcdKernel, NonFiniteInputIsConservative) {
 // to rounding, far below δ), so the answer must be "collides" with toi <= t* (+ rounding).
 TEST(CcdKernel, RandomCollidingQueries) {
   test::Rng rng(20240611);
-  auto rnd = [&] { return Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)); };
+  auto rnd = [&] { return rng.vec3(-1, 1); };
   int limit_hits = 0;
   for (int q = 0; q < 2000; ++q) {
     const int tcase = q % 10;
@@ -488,7 +486,7 @@ TEST(CcdKernel, RandomCollidingQueries) {
 // these apart, so none is reported now, and any that were would have to meet the bound).
 TEST(CcdKernel, AReportedToiIsATimeWhenThePrimitivesAreWithinTolerance) {
   test::Rng rng(5150);
-  auto rnd = [&] { return Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)); };
+  auto rnd = [&] { return rng.vec3(-1, 1); };
   int reported = 0, near_misses = 0, near_misses_reported = 0;
   for (int q = 0; q < 4000; ++q) {
     const bool vf = q % 2 == 0;
@@ -550,8 +548,8 @@ TEST(CcdKernel, AReportedToiIsATimeWhenThePrimitivesAreWithinTolerance) {
 // stay below z = 0: never a collision, and with a gap of 0.1 not even a near miss.
 TEST(CcdKernel, RandomSeparatedQueries) {
   test::Rng rng(77);
-  auto below = [&] { return Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 0)); };
-  auto above = [&] { return Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(0.1, 1)); };
+  auto below = [&] { return Vec3{rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 0)}; };
+  auto above = [&] { return Vec3{rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(0.1, 1)}; };
   for (int q = 0; q < 2000; ++q) {
     if (q % 2 == 0) {
       const P4 s{above(), below(), below(), below()}, e{above(), below(), below(), below()};
@@ -570,11 +568,13 @@ TEST(CcdKernel, SharesOfTwoPointSetsCoverTheirPairsTolerance) {
   int close = 0;
   for (int k = 0; k < 20000; ++k) {
     const double scale = std::pow(10.0, rng.uniform(-8, 8));
-    const double offset = std::pow(10.0, rng.uniform(-8, 12)) * (rng.uniform(0, 1) < 0.5 ? -1 : 1);
+    const double power = std::pow(10.0, rng.uniform(-8, 12));
+    const double offset = power * (rng.uniform(0, 1) < 0.5 ? -1 : 1);
     auto box = [&](AABB& b) {
-      const Vec3 lo = Vec3::Constant(offset) + scale * Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+      const Vec3 lo = Vec3::Constant(offset) + scale * rng.vec3(-1, 1);
       b.lo = lo;
-      b.hi = lo + scale * rng.uniform(0, 1) * Vec3(rng.uniform(0, 1), rng.uniform(0, 1), rng.uniform(0, 1));
+      const double size = rng.uniform(0, 1);
+      b.hi = lo + scale * size * rng.vec3(0, 1);
     };
     AABB a, b;
     box(a);

@@ -112,7 +112,7 @@ TEST(CcdStage2, EveryPointSweptWithinTheMarginIsInAMarkedVoxelOfItsSlot) {
             double u = rng.uniform(0, 1), v = rng.uniform(0, 1);
             if (u + v > 1) u = 1 - u, v = 1 - v;
             if (sample % 4 == 0) u = 0, v = sample % 8 == 0 ? 0 : 1;
-            Vec3 off(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+            Vec3 off = rng.vec3(-1, 1);
             if (sample % 3 == 0) off = off.array().sign();
             const Vec3 q = point_at(from, to, o, t, std::clamp(tau, 0.0, 1.0), u, v) + sweep.margin * off;
             const Vec3 rel = (q - g.origin) / g.cell;

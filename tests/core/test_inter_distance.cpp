@@ -53,7 +53,7 @@ TEST(InterDistance, TriangleSoupsWithManyIntersectionsEqualBruteForce) {
     Rng rng(seed);
     Frame frame;
     for (int i = 0; i < 6; ++i)
-      frame.objects.push_back(make_soup(rng, Vec3(rng.uniform(0, 2), rng.uniform(0, 2), 0), 0.6, 0.4,
+      frame.objects.push_back(make_soup(rng, Vec3{rng.uniform(0, 2), rng.uniform(0, 2), 0}, 0.6, 0.4,
                                         30, "soup" + std::to_string(i)));
     const auto ref = inter_object_distance_brute_force(frame);
     test::expect_same_inter(inter_object_distance(frame, {2}), ref, "soup seed " + std::to_string(seed));
@@ -138,7 +138,7 @@ TEST(TriangleBvh, QueryOverlapsSkipsOnlyWhatNodeUnionsExclude) {
   std::vector<AABB> second(first.size());
   Rng rng(5);
   for (size_t t = 0; t < first.size(); ++t) {
-    const Vec3 shift(rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5));
+    const Vec3 shift = rng.vec3(-0.5, 0.5);
     second[t] = {first[t].lo + shift, first[t].hi + shift};
   }
   TriangleBvh bvh;
@@ -184,7 +184,7 @@ TEST(TriangleBvh, AnyWithinAgreesWithAScanOfTheBoxes) {
     Vec3 p;
     for (int k = 0; k < 3; ++k) p[k] = rng.uniform(around.lo[k] - 0.5, around.hi[k] + 0.5);
     query.extend(p);
-    if (q % 2) query.extend(p + Vec3(rng.uniform(0, 0.3), rng.uniform(0, 0.3), rng.uniform(0, 0.3)));
+    if (q % 2) query.extend(p + rng.vec3(0, 0.3));
     const double bound = q % 7 == 0 ? 0.0 : rng.uniform(0, 1.0);
     bool want = false;
     for (const AABB& b : mine) want = want || box_distance_squared(query, b) <= bound * bound;
@@ -439,7 +439,7 @@ TEST(ObjectBroadPhase, CrowdOfSmallObjects) {
     Frame frame;
     const double side = 20;
     for (int i = 0; i < 300; ++i) {
-      const Vec3 c(rng.uniform(0, side), rng.uniform(0, side), rng.uniform(0, side));
+      const Vec3 c = rng.vec3(0, side);
       frame.objects.push_back(make_soup(rng, c, 0.2, 0.5, 1 + i % 3, "o" + std::to_string(i)));
     }
     const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
@@ -500,11 +500,11 @@ TEST(ObjectBroadPhase, LongParallelSticksKeepLocalBounds) {
 Frame nested_frame(std::uint64_t seed) {
   Rng rng(seed);
   Frame frame;
-  const Vec3 c(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+  const Vec3 c = rng.vec3(-1, 1);
   for (int k = 0; k < 6; ++k)
     frame.objects.push_back(make_blob(rng, c, 1.0 + 0.35 * k, 2, 0.03, "shell" + std::to_string(k)));
   for (int k = 0; k < 4; ++k) {
-    const Vec3 at = c + Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)).normalized() * 2.6;
+    const Vec3 at = c + rng.vec3(-1, 1).normalized() * 2.6;
     frame.objects.push_back(make_blob(rng, at, 0.1, 1, 0.2, "grain" + std::to_string(k)));
   }
   frame.objects.push_back(make_blob(rng, c + Vec3(0.5, 0, 0), 1.5, 2, 0.03, "off-centre"));

@@ -33,8 +33,7 @@ Frame mixed_frame(std::uint64_t seed) {
   Frame frame = make_random_frame(seed, 2 + static_cast<int>(seed % 7), 1.0 + 0.4 * static_cast<double>(seed % 4), 1);
   Rng rng(seed * 77);
   for (int k = 0; k < 2; ++k)
-    frame.objects.push_back(make_soup(rng, Vec3(rng.uniform(0, 2), rng.uniform(0, 2), rng.uniform(0, 2)),
-                                      0.5, 0.3, 25, "soup" + std::to_string(k)));
+    frame.objects.push_back(make_soup(rng, rng.vec3(0, 2), 0.5, 0.3, 25, "soup" + std::to_string(k)));
   return frame;
 }
 
@@ -80,10 +79,10 @@ TEST(IntersectingPairs, FanAroundAHubWithCrossingTrianglesEqualsBruteForce) {
   Rng rng(3);
   for (int c = 0; c < 12; ++c) {
     const Index base = static_cast<Index>(o.positions.size());
-    const Vec3 at(rng.uniform(-0.7, 0.7), rng.uniform(-0.7, 0.7), 0);
-    o.positions.push_back(at + Vec3(rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), -0.2));
-    o.positions.push_back(at + Vec3(rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), 0.2));
-    o.positions.push_back(at + Vec3(rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), 0.25));
+    const Vec3 at{rng.uniform(-0.7, 0.7), rng.uniform(-0.7, 0.7), 0};
+    o.positions.push_back(at + Vec3{rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), -0.2});
+    o.positions.push_back(at + Vec3{rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), 0.2});
+    o.positions.push_back(at + Vec3{rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), 0.25});
     topo->faces.push_back({base, base + 1, base + 2});
   }
   topo->num_vertices = static_cast<Index>(o.positions.size());
@@ -108,9 +107,12 @@ TEST(TrianglePlane, RejectsOnlyBoxesStrictlyOnOneSide) {
   for (int q = 0; q < 200000; ++q) {
     const double scale = std::pow(10.0, rng.uniform(-8, 8));
     const double offset = q % 3 == 0 ? 0.0 : std::pow(10.0, rng.uniform(-8, 12)) * (q % 2 ? 1 : -1);
-    auto point = [&]() -> Vec3 { return Vec3::Constant(offset) + scale * Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)); };
+    auto point = [&]() -> Vec3 { return Vec3::Constant(offset) + scale * rng.vec3(-1, 1); };
     Triangle t{point(), point(), point()};
-    if (q % 7 == 0) t[2] = t[0] + (t[1] - t[0]) * rng.uniform(-1, 2) + scale * 1e-12 * Vec3(rng.uniform(-1, 1), 0, 0);
+    if (q % 7 == 0) {
+      const double along = rng.uniform(-1, 2);
+      t[2] = t[0] + (t[1] - t[0]) * along + scale * 1e-12 * Vec3(rng.uniform(-1, 1), 0, 0);
+    }
     // A box centred near the plane, at a distance from 0 to 10 box sizes off it.
     const Vec3 nrm = (t[1] - t[0]).cross(t[2] - t[0]);
     const double len = nrm.norm();
@@ -120,8 +122,8 @@ TEST(TrianglePlane, RejectsOnlyBoxesStrictlyOnOneSide) {
     const double off = size * std::pow(10.0, rng.uniform(-9, 1)) * (q % 4 < 2 ? 1 : -1);
     const Vec3 c = t[0] + (t[1] - t[0]) * rng.uniform(0, 1) + dir * off;
     AABB box;
-    box.extend(c - size * Vec3(rng.uniform(0, 1), rng.uniform(0, 1), rng.uniform(0, 1)));
-    box.extend(c + size * Vec3(rng.uniform(0, 1), rng.uniform(0, 1), rng.uniform(0, 1)));
+    box.extend(c - size * rng.vec3(0, 1));
+    box.extend(c + size * rng.vec3(0, 1));
     if (!TrianglePlane(t).rejects(box)) continue;
     ++rejected;
     close += std::abs(off) < 2 * size;

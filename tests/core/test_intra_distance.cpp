@@ -405,8 +405,7 @@ TEST(IntraStage2, DefaultGridFollowsTheMedianTriangleInCrowds) {
   Frame frame;
   Rng rng(5);
   for (int k = 0; k < 1000; ++k)
-    frame.objects.push_back(test::make_blob(rng, Vec3(rng.uniform(0, 30), rng.uniform(0, 30), rng.uniform(0, 30)), 0.5, 1,
-                                            0.1, "b" + std::to_string(k)));
+    frame.objects.push_back(test::make_blob(rng, rng.vec3(0, 30), 0.5, 1, 0.1, "b" + std::to_string(k)));
   const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
   const auto ring2 = ring2_upper_bounds(frame, 2);
   auto backend = make_cpu_self_voronoi_backend(2);

@@ -206,7 +206,7 @@ Int128 int_orient3d(const std::array<std::int64_t, 12>& p) {
 
 Vec3 random_point(std::mt19937_64& rng, double half_size, double offset = 0.0) {
   std::uniform_real_distribution<double> u(-half_size, half_size);
-  return Vec3(offset + u(rng), offset + u(rng), offset + u(rng));
+  return Vec3{offset + u(rng), offset + u(rng), offset + u(rng)};
 }
 
 /// x moved by `steps` ulps (toward +inf when positive).
@@ -318,8 +318,8 @@ TEST(Orient3d, ConstructedCoplanarPointsGiveZeroAndOneUlpOffGivesTheSide) {
   for (double offset : {0.0, 1e6, -2.5e5}) {
     for (int trial = 0; trial < 3000; ++trial) {
       auto grid_point = [&]() {
-        return Vec3(offset + std::ldexp(grid(rng), -10), offset + std::ldexp(grid(rng), -10),
-                    offset + std::ldexp(grid(rng), -10));
+        return Vec3{offset + std::ldexp(grid(rng), -10), offset + std::ldexp(grid(rng), -10),
+                    offset + std::ldexp(grid(rng), -10)};
       };
       const Vec3 a = grid_point(), b = grid_point(), c = grid_point();
       const double alpha = frac(rng) / 16.0;
@@ -446,8 +446,8 @@ TEST(Orient2d, RandomNearCollinearMatchesTwin) {
   std::uniform_int_distribution<int> step(-2, 2);
   for (double offset : {0.0, 1e6}) {
     for (int trial = 0; trial < 20000; ++trial) {
-      const Vec2 a(offset + unit(rng), offset + unit(rng));
-      const Vec2 b(offset + unit(rng), offset + unit(rng));
+      const Vec2 a{offset + unit(rng), offset + unit(rng)};
+      const Vec2 b{offset + unit(rng), offset + unit(rng)};
       const double t = unit(rng) * 3 - 1;
       Vec2 c = a + t * (b - a);
       c[0] = ulp_step(c[0], step(rng));
@@ -460,8 +460,13 @@ TEST(Orient2d, RandomNearCollinearMatchesTwin) {
   }
   // Small integers, many exactly collinear.
   std::uniform_int_distribution<int> coord(-3, 3);
+  auto int_point = [&] {
+    Vec2 p;
+    for (int k = 0; k < 2; ++k) p[k] = coord(rng);
+    return p;
+  };
   for (int trial = 0; trial < 50000; ++trial) {
-    const Vec2 a(coord(rng), coord(rng)), b(coord(rng), coord(rng)), c(coord(rng), coord(rng));
+    const Vec2 a = int_point(), b = int_point(), c = int_point();
     const double det = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);  // exact
     ASSERT_EQ(orient2d(a, b, c), (det > 0) - (det < 0));
   }
@@ -470,9 +475,13 @@ TEST(Orient2d, RandomNearCollinearMatchesTwin) {
 TEST(Orient2dProjected, IsTheSignOfTheCrossProductComponent) {
   std::mt19937_64 rng(8);
   std::uniform_int_distribution<int> coord(-3, 3);
+  auto int_point = [&] {
+    Vec3 p;
+    for (int k = 0; k < 3; ++k) p[k] = coord(rng);
+    return p;
+  };
   for (int trial = 0; trial < 20000; ++trial) {
-    const Vec3 a(coord(rng), coord(rng), coord(rng)), b(coord(rng), coord(rng), coord(rng)),
-        c(coord(rng), coord(rng), coord(rng));
+    const Vec3 a = int_point(), b = int_point(), c = int_point();
     const Vec3 n = (b - a).cross(c - a);  // exact for small integers
     for (int axis = 0; axis < 3; ++axis) {
       ASSERT_EQ(orient2d_projected(a, b, c, axis), (n[axis] > 0) - (n[axis] < 0));

@@ -252,7 +252,7 @@ TEST(Stage2, LowerBoundsHoldForAnObjectNearManyOthers) {
     Frame frame;
     frame.objects.push_back(make_sheet(20, 6.0, "floor"));
     for (int k = 0; k < 14; ++k) {
-      const Vec3 c(rng.uniform(0.5, 3.0), rng.uniform(0.5, 3.0), rng.uniform(-0.1, 0.5));
+      const Vec3 c{rng.uniform(0.5, 3.0), rng.uniform(0.5, 3.0), rng.uniform(-0.1, 0.5)};
       frame.objects.push_back(test::make_blob(rng, c, rng.uniform(0.15, 0.3), 1, 0.2, "grain" + std::to_string(k)));
     }
     const auto all = static_cast<std::uint64_t>(frame.objects[0].num_triangles() + 14 * frame.objects[1].num_triangles());
@@ -333,8 +333,8 @@ TEST(Stage2, GridHasExactlyTheRequestedCellsAlongTheLongestAxis) {
   for (int trial = 0; trial < 20000; ++trial) {
     const int n = 1 + static_cast<int>(rng.uniform(0, 600));
     AABB box;
-    box.extend(Vec3(rng.uniform(-3, 3), rng.uniform(-3, 3), rng.uniform(-3, 3)));
-    box.extend(Vec3(rng.uniform(-3, 3), rng.uniform(-3, 3), rng.uniform(-3, 3)));
+    box.extend(rng.vec3(-3, 3));
+    box.extend(rng.vec3(-3, 3));
     const StageGrid sg = StageGrid::over(box, n);
     const Vec3 ext = box.hi - box.lo;
     int longest = 0;

@@ -245,7 +245,7 @@ TriangleDistanceResult check_pair(const Triangle& a, const Triangle& b, ErrorSta
 
 Vec3 random_vec(std::mt19937_64& rng, double half_size) {
   std::uniform_real_distribution<double> u(-half_size, half_size);
-  return Vec3(u(rng), u(rng), u(rng));
+  return Vec3{u(rng), u(rng), u(rng)};
 }
 
 Triangle random_triangle(std::mt19937_64& rng, const Vec3& center, double half_size) {
@@ -320,9 +320,12 @@ TEST(PointTriangle, CapSliversMatchTwin) {
       const Vec3 a = shift + random_vec(rng, 1.0);
       const Vec3 b = shift + random_vec(rng, 1.0);
       const double height = std::pow(10.0, -4.0 - 14.0 * unit01(rng));
-      const Vec3 c = a + unit01(rng) * (b - a) + height * random_vec(rng, 1.0);
+      const double along_c = unit01(rng);
+      const Vec3 c = a + along_c * (b - a) + height * random_vec(rng, 1.0);
       const Triangle t = {a, b, c};
-      const Vec3 p = a + unit01(rng) * (b - a) + std::pow(10.0, -6.0 * unit01(rng)) * random_vec(rng, 1.0);
+      const double along_p = unit01(rng);
+      const double offset_p = std::pow(10.0, -6.0 * unit01(rng));
+      const Vec3 p = a + along_p * (b - a) + offset_p * random_vec(rng, 1.0);
       const PointTriangleResult r = point_triangle_distance(p, t);
       const double unit = kEpsilon * scale_of({a, b, c, p});
       const double d_twin = static_cast<double>(twin_point_triangle(p, t));
@@ -435,7 +438,8 @@ TEST(TriangleIntersection, SmallIntegerTrianglesAgreeExactlyWithTwin) {
   std::uniform_int_distribution<int> coord(0, 3);
   auto grid_triangle = [&]() {
     Triangle t;
-    for (Vec3& c : t) c = Vec3(coord(rng), coord(rng), coord(rng));
+    for (Vec3& c : t)
+      for (int k = 0; k < 3; ++k) c[k] = coord(rng);
     return t;
   };
   int intersecting = 0, degenerate = 0, coplanar = 0;

@@ -27,18 +27,26 @@ namespace {
 Frame scene_of_kind(test::Rng& rng, std::uint64_t seed) {
   Frame f;
   switch (seed % 5) {
-    case 0:
-      f = test::make_random_frame(seed, 2 + static_cast<int>(rng.uniform(0, 8)), rng.uniform(0.5, 4),
-                                  rng.uniform(0, 1) < 0.3 ? 2 : 1);
+    case 0: {
+      const int n = 2 + static_cast<int>(rng.uniform(0, 8));
+      const double spread = rng.uniform(0.5, 4);
+      const int levels = rng.uniform(0, 1) < 0.3 ? 2 : 1;
+      f = test::make_random_frame(seed, n, spread, levels);
       break;
+    }
     case 1:
-      for (int i = 0; i < 3; ++i)
-        f.objects.push_back(test::make_soup(rng, Vec3(rng.uniform(0, 1.5), 0, 0), 0.5, rng.uniform(0.05, 0.4), 30,
-                                            "soup" + std::to_string(i)));
+      for (int i = 0; i < 3; ++i) {
+        const Vec3 at(rng.uniform(0, 1.5), 0, 0);
+        const double size = rng.uniform(0.05, 0.4);
+        f.objects.push_back(test::make_soup(rng, at, 0.5, size, 30, "soup" + std::to_string(i)));
+      }
       break;
     case 2:
-      f.objects.push_back(test::make_folded_sheet(rng, 12, 6, 0.1, rng.uniform(0.001, 0.3), rng.uniform(0, 0.1)));
-      f.objects.push_back(test::make_folded_sheet(rng, 8, 5, 0.1, rng.uniform(0.001, 0.3), rng.uniform(0, 0.1)));
+      for (const auto& [nx, ny] : {std::pair{12, 6}, std::pair{8, 5}}) {
+        const double gap = rng.uniform(0.001, 0.3);
+        const double jitter = rng.uniform(0, 0.1);
+        f.objects.push_back(test::make_folded_sheet(rng, nx, ny, 0.1, gap, jitter));
+      }
       for (Vec3& p : f.objects[1].positions) p += Vec3(0.05, 0.05, rng.uniform(-0.2, 0.4));
       break;
     case 3: {  // an exact copy and a shifted copy: ties between objects
@@ -60,8 +68,10 @@ Frame scene_of_kind(test::Rng& rng, std::uint64_t seed) {
   const double scales[] = {1e-4, 1e-2, 1, 1e3};
   const double s = scales[static_cast<int>(rng.uniform(0, 4)) % 4];
   Vec3 offset = Vec3::Zero();
-  if (rng.uniform(0, 1) < 0.5)
-    offset = Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)) * s * std::pow(10.0, rng.uniform(0, 5));
+  if (rng.uniform(0, 1) < 0.5) {
+    const Vec3 direction = rng.vec3(-1, 1);
+    offset = direction * s * std::pow(10.0, rng.uniform(0, 5));
+  }
   for (Object& o : f.objects)
     for (Vec3& p : o.positions) p = p * s + offset;
   return f;
@@ -77,10 +87,10 @@ Frame next_frame(const Frame& from, const FrameBoxes& boxes, std::uint64_t seed)
   Frame to = from;
   to.index = from.index + 1;
   for (Object& o : to.objects) {
-    const Vec3 drift(rng.uniform(-0.2, 0.2) * d, rng.uniform(-0.2, 0.2) * d, rng.uniform(-0.2, 0.2) * d);
+    const Vec3 drift = rng.vec3(-0.2, 0.2) * d;
     const double jitter = rng.uniform(0, 0.05) * d;
     for (Vec3& p : o.positions)
-      p += drift + Vec3(rng.uniform(-jitter, jitter), rng.uniform(-jitter, jitter), rng.uniform(-jitter, jitter));
+      p += drift + rng.vec3(-jitter, jitter);
   }
   return to;
 }

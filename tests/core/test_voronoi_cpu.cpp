@@ -65,11 +65,11 @@ DvdInput random_scene(unsigned seed, const SceneOptions& options) {
   auto inside = [&](const Vec3& p) -> Vec3 { return p.cwiseMax(Vec3::Zero()).cwiseMin(size); };
   std::vector<Vec3> centres;
   for (int s = 0; s < options.sites; ++s) {
-    centres.push_back(Vec3(unit(rng), unit(rng), unit(rng)).cwiseProduct(size));
+    centres.push_back(Vec3{unit(rng), unit(rng), unit(rng)}.cwiseProduct(size));
   }
   std::uniform_int_distribution<int> pick_site(0, options.sites - 1);
   auto jitter = [&](double scale) -> Vec3 {
-    return scale * Vec3(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5);
+    return scale * Vec3{unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5};
   };
   for (int i = 0; i < options.triangles; ++i) {
     const int site = pick_site(rng);
@@ -368,7 +368,7 @@ TEST(VoronoiBins, EveryTriangleWithinRadiusIsFound) {
     std::int64_t checked = 0;
     for (int i = 0; i < 400; ++i) {
       // Points inside and slightly outside the grid, radii from 0 to a third of the grid.
-      const Vec3 q = Vec3(unit(rng) * 1.2 - 0.1, unit(rng) * 1.2 - 0.1, unit(rng) * 1.2 - 0.1)
+      const Vec3 q = Vec3{unit(rng) * 1.2 - 0.1, unit(rng) * 1.2 - 0.1, unit(rng) * 1.2 - 0.1}
                          .cwiseProduct(size);
       std::vector<double> distances(in.tri_site.size());
       for (std::size_t t = 0; t < distances.size(); ++t) {

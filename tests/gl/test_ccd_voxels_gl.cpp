@@ -117,8 +117,8 @@ TEST(CcdVoxelsGl, PipelineCullingEqualsTheCpuBackend) {
     Frame to = from;
     to.index = 1;
     for (Object& o : to.objects) {
-      const Vec3 d(rng.uniform(-0.6, 0.6), rng.uniform(-0.6, 0.6), rng.uniform(-0.6, 0.6));
-      for (Vec3& p : o.positions) p += d + Vec3(rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2));
+      const Vec3 d = rng.vec3(-0.6, 0.6);
+      for (Vec3& p : o.positions) p += d + rng.vec3(-0.2, 0.2);
     }
     const CcdSweep sweep = CcdSweep::compute(from, to, 2);
     const CcdStepResult ref = continuous_collisions_brute_force(from, to);

@@ -122,7 +122,7 @@ TEST(GlSelfVoronoi, SamplesBeyondADriversLoopCapAgreeWithTheCpu) {
   std::mt19937 rng(71);
   std::uniform_real_distribution<double> unit(0.8, 1.2);
   for (std::int32_t t = 0; t < 70000; ++t) {
-    const Vec3 a(unit(rng), unit(rng), unit(rng));
+    const Vec3 a{unit(rng), unit(rng), unit(rng)};
     for (const Vec3& c : {a, Vec3(a + Vec3(0.01, 0, 0)), Vec3(a + Vec3(0, 0.01, 0.003))})
       for (int k = 0; k < 3; ++k) {
         d.tri_xyz_d.push_back(c[k]);

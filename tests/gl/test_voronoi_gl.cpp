@@ -171,11 +171,11 @@ DvdInput random_scene(unsigned seed, const SceneOptions& options) {
     return in.grid.origin + relative.cwiseMax(Vec3::Zero()).cwiseMin(size);
   };
   auto jitter = [&](double scale) -> Vec3 {
-    return scale * Vec3(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5);
+    return scale * Vec3{unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5};
   };
   std::vector<Vec3> centres;
   for (int s = 0; s < options.sites; ++s) {
-    centres.push_back(Vec3(unit(rng), unit(rng), unit(rng)).cwiseProduct(size));
+    centres.push_back(Vec3{unit(rng), unit(rng), unit(rng)}.cwiseProduct(size));
   }
   std::uniform_int_distribution<int> pick_site(0, options.sites - 1);
   for (int i = 0; i < options.triangles; ++i) {
@@ -355,7 +355,7 @@ TEST(GlVoronoi, SliversCapsAndNeedlesStayWithinTheBound) {
         const std::int64_t id = x + 256 * (y + std::int64_t{256} * z);
         const Vec3 q = in.grid.origin + sample_point(in.grid, id);
         // A random orthonormal frame.
-        const Vec3 n = Vec3(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5).normalized();
+        const Vec3 n = Vec3{unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5}.normalized();
         const Vec3 u1 = n.unitOrthogonal();
         const Vec3 u2 = n.cross(u1);
         auto at = [&](double s, double t, double h) -> Vec3 { return q + s * u1 + t * u2 - h * n; };
@@ -452,8 +452,8 @@ TEST(GlVoronoi, GridsOfMoreThan2To32VoxelsMatchTheReference) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   const Vec3 corner = in.grid.origin + in.grid.cell * Vec3(4090, 4090, 506);
   for (int t = 0; t < 30; ++t) {
-    const Vec3 a = corner + 2.0 * Vec3(unit(rng), unit(rng), unit(rng));
-    add_triangle(in, {a, a + Vec3(unit(rng), unit(rng), unit(rng)), a + Vec3(unit(rng), unit(rng), unit(rng))}, t % 3);
+    const Vec3 a = corner + 2.0 * Vec3{unit(rng), unit(rng), unit(rng)};
+    add_triangle(in, {a, a + Vec3{unit(rng), unit(rng), unit(rng)}, a + Vec3{unit(rng), unit(rng), unit(rng)}}, t % 3);
   }
   for (std::int64_t z = 502; z < 510; ++z)
     for (std::int64_t y = 4086; y < 4094; ++y)
@@ -483,7 +483,7 @@ TEST(GlVoronoi, SamplesBeyondADriversLoopCapMatchTheReference) {
   std::mt19937 rng(70000);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (int t = 0; t < 70000; ++t) {
-    const Vec3 a = in.grid.origin + Vec3(0.8 + 0.4 * unit(rng), 0.8 + 0.4 * unit(rng), 0.8 + 0.4 * unit(rng));
+    const Vec3 a = in.grid.origin + Vec3{0.8 + 0.4 * unit(rng), 0.8 + 0.4 * unit(rng), 0.8 + 0.4 * unit(rng)};
     add_triangle(in, {a, a + Vec3(0.01, 0, 0), a + Vec3(0, 0.01, 0.003)}, t % 5);
   }
   for (std::int64_t v : {0, 9, 73, 146, 292, 365, 438, 511}) {
@@ -526,7 +526,7 @@ DvdInput sphere_scene(int spheres, double radius_cells, int grid, unsigned seed)
   std::set<std::int64_t> voxels;
   for (int s = 0; s < spheres; ++s) {
     const Vec3 centre = in.grid.origin + Vec3::Constant(r + in.grid.cell) +
-                        (size - 2 * (r + in.grid.cell)) * Vec3(unit(rng), unit(rng), unit(rng));
+                        (size - 2 * (r + in.grid.cell)) * Vec3{unit(rng), unit(rng), unit(rng)};
     auto point = [&](int i, int j) -> Vec3 {
       const double phi = 2 * kPi * i / kSlices, theta = kPi * j / (kStacks - 1);
       return centre + r * Vec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),

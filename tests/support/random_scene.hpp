@@ -14,6 +14,13 @@
 namespace vproxq::test {
 
 /// splitmix64: the same numbers on every platform (std distributions are not portable).
+///
+/// Draw order: C++ leaves unspecified the order in which the arguments of one call, or the
+/// operands of one operator, are evaluated (GCC evaluates a call's arguments right to left,
+/// clang left to right). Two draws in one such expression, e.g. `Vec3(rng.uniform(a, b),
+/// rng.uniform(a, b), ...)`, would make the two compilers build different scenes, so the tests
+/// draw in reading order: in separate statements, in braced lists (`Vec3{...}`, ordered by the
+/// standard), or with vec3().
 class Rng {
  public:
   explicit Rng(std::uint64_t seed) : s_(seed) {}
@@ -25,6 +32,14 @@ class Rng {
   }
   double uniform(double lo, double hi) { return lo + (hi - lo) * (next() >> 11) * 0x1.0p-53; }
   int integer(int lo, int hi) { return lo + static_cast<int>(next() % static_cast<std::uint64_t>(hi - lo + 1)); }
+  /// A vector with each coordinate uniform in [lo, hi), drawn x, then y, then z: separate
+  /// statements, so that GCC and clang build the same scenes (see above).
+  Vec3 vec3(double lo, double hi) {
+    const double x = uniform(lo, hi);
+    const double y = uniform(lo, hi);
+    const double z = uniform(lo, hi);
+    return Vec3(x, y, z);
+  }
 
  private:
   std::uint64_t s_;
@@ -73,7 +88,7 @@ inline Frame make_random_frame(std::uint64_t seed, int n, double spread, int lev
   Rng rng(seed);
   Frame frame;
   for (int i = 0; i < n; ++i) {
-    const Vec3 c(rng.uniform(0, spread), rng.uniform(0, spread), rng.uniform(0, spread));
+    const Vec3 c = rng.vec3(0, spread);
     frame.objects.push_back(make_blob(rng, c, rng.uniform(0.3, 1.0), levels, 0.3, "blob" + std::to_string(i)));
   }
   return frame;
@@ -86,11 +101,10 @@ inline Object make_soup(Rng& rng, const Vec3& center, double extent, double size
   Object o;
   o.name = name;
   for (int t = 0; t < n; ++t) {
-    const Vec3 c = center + Vec3(rng.uniform(-extent, extent), rng.uniform(-extent, extent),
-                                 rng.uniform(-extent, extent));
+    const Vec3 c = center + rng.vec3(-extent, extent);
     const Index base = static_cast<Index>(o.positions.size());
     for (int k = 0; k < 3; ++k)
-      o.positions.push_back(c + Vec3(rng.uniform(-size, size), rng.uniform(-size, size), rng.uniform(-size, size)));
+      o.positions.push_back(c + rng.vec3(-size, size));
     topo->faces.push_back({base, base + 1, base + 2});
   }
   topo->num_vertices = static_cast<Index>(o.positions.size());
@@ -106,9 +120,8 @@ inline Frame moved(const Frame& from, std::uint64_t seed, double drift, double j
   to.index = from.index + 1;
   for (const Object& o : from.objects) {
     Object m = o;  // shares the topology pointer
-    const Vec3 d(rng.uniform(-drift, drift), rng.uniform(-drift, drift), rng.uniform(-drift, drift));
-    for (Vec3& p : m.positions)
-      p += d + Vec3(rng.uniform(-jitter, jitter), rng.uniform(-jitter, jitter), rng.uniform(-jitter, jitter));
+    const Vec3 d = rng.vec3(-drift, drift);
+    for (Vec3& p : m.positions) p += d + rng.vec3(-jitter, jitter);
     to.objects.push_back(std::move(m));
   }
   return to;

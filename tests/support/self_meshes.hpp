@@ -48,7 +48,7 @@ inline Object make_folded_sheet(Rng& rng, int nx, int ny, double cell, double ga
       } else {
         p = Vec3(fold - (s - fold - M_PI * r), y, 2 * r);
       }
-      p += cell * jitter * Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+      p += cell * jitter * rng.vec3(-1, 1);
       v.push_back(p);
     }
   std::vector<Face> f;
