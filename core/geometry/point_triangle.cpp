@@ -6,17 +6,26 @@
 namespace vproxq {
 namespace {
 
-/// Smallest sin^2 of the triangle's largest angle for which the plain normal is used.
-/// The normal is the cross product of the two edges at the corner opposite the longest edge
-/// (the largest angle), computed in double: rounding of the edge differences and products gives
-/// it an absolute error of about 4e|e1||e2| (e = 2^-53), a direction error of about
-/// 4e/sin(angle) radians. For sin >= 1e-3 that is below 5e-13 rad, and the face candidate, a
-/// convex combination of the corners, is then accurate (its error is second order in that
-/// angle). Below it (caps: nearly collinear corners, where barycentric coordinates along the
-/// long side lose ~e/sin of their accuracy) the normal is recomputed accurately (see
-/// accurate_normal) and the face candidate is the orthogonal projection onto that plane. The
-/// threshold only moves work between the two paths; both are accurate on their side of it.
-constexpr double kWellShapedSinSq = 1e-6;
+/// Smallest |n|^2 / L^4 (n the normal below, L the longest edge; |n| is twice the area) for which
+/// the plain normal and the convex-combination face candidate are used: twice the area at least
+/// 1e-3 L^2. The normal is the cross product of the two edges at the corner opposite the longest
+/// edge (the largest angle), computed in double: rounding of the edge differences and products
+/// gives it an absolute error of about 4e|e1||e2| (e = 2^-53), a direction error of about
+/// 4e/sin(angle) radians, below 5e-13 rad here. The face candidate is built from barycentric
+/// coordinates side_k / sum, where each side_k has an absolute error of about e |edge| |p - corner|
+/// |n| and sum is about |n|^2: the point is off by at most about e L^2 |p - corner| / |n| along the
+/// triangle (a crude bound: for 3.4 million needles with |n| / L^2 between 1e-3 and 1e-1, queried
+/// from points just off them, the distance was within 0.003 e*S). Two shapes fail this and take the
+/// other path: caps (nearly collinear corners, largest angle near 180 degrees) and needles (one
+/// edge short beside two long ones: |n| ~ L times the short edge). Needles used to pass the test,
+/// made on the largest angle alone: for needles 2 long in the plane, queried from points just off
+/// them, the distance was off by up to 8e-13 with a short edge below 1e-3, 1e-8 below 1e-5 and
+/// about 1 below 1e-12 (now within 1 e*S: the test PointTriangle.NeedlesMatchTheirKnownDistance).
+/// On the other path the normal is recomputed accurately (see accurate_normal) and the face
+/// candidate is the orthogonal projection onto that plane, whose distance is accurate to about
+/// e |p - corner| for any shape; the projection is also compared with all three edges. The threshold
+/// only moves work between the two paths; both are accurate on their side of it.
+constexpr double kWellShapedAreaSq = 1e-6;
 
 /// Smallest sin of the largest angle for which a cap's accurate normal is trusted: its error is
 /// about e|n| + 4e^2|e1||e2|, i.e. a direction error of about e + 4e^2/sin; at sin = 64e that
@@ -83,7 +92,7 @@ PreparedTriangle prepare_triangle(const Triangle& t) {
   pt.normal = pt.edges[j].cross(pt.edges[j1]);
   pt.normal_sq = pt.normal.squaredNorm();
   const double edges_sq = len_sq[j] * len_sq[j1];  // |e1|^2 |e2|^2
-  pt.well_shaped = pt.normal_sq >= kWellShapedSinSq * edges_sq && pt.normal_sq > 0.0;
+  pt.well_shaped = pt.normal_sq >= kWellShapedAreaSq * (len_sq[longest] * len_sq[longest]) && pt.normal_sq > 0.0;
   if (!pt.well_shaped) {
     // At the same corner j1 (opposite the longest edge), with the same orientation.
     pt.normal = accurate_normal(t[j1], t[(j1 + 1) % 3], t[(j1 + 2) % 3]);

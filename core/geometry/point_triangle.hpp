@@ -30,7 +30,7 @@ struct PreparedTriangle {
   Vec3 normal;         ///< (c1-c0) x (c2-c0), at the corner opposite the longest edge;
                        ///< recomputed accurately when not well_shaped (point_triangle.cpp)
   double normal_sq;    ///< |normal|^2; 0 for a flat (degenerate) triangle: the edges decide
-  bool well_shaped;    ///< largest angle's sin >= 1e-3: the plain normal is accurate enough
+  bool well_shaped;    ///< |normal| >= 1e-3 (longest edge)^2: neither a cap nor a needle
 };
 
 /// Computes the PreparedTriangle of t.
@@ -40,8 +40,9 @@ PreparedTriangle prepare_triangle(const Triangle& t);
 ///
 /// When the projection of p falls inside a well-shaped triangle, the closest point is that
 /// projection (region Face), built as a convex combination of the corners; otherwise it is on
-/// the edges whose inner side p is not on. A cap (largest angle's sin < 1e-3) uses an
-/// accurately computed normal and compares the projection with all three edges. A flat
+/// the edges whose inner side p is not on. A cap or a needle (twice the area below 1e-3 times
+/// the longest edge squared: nearly collinear corners, or one edge much shorter than the other
+/// two) uses an accurately computed normal and compares the projection with all three edges. A flat
 /// triangle (collinear or repeated corners, or sin < 64e) is the union of its edges: the result
 /// is the distance to the nearest edge, region Vertex or Edge. Ties go to Face, then Edge0..2.
 PointTriangleResult point_triangle_distance(const Vec3& p, const Triangle& t);

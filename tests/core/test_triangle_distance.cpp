@@ -339,6 +339,47 @@ TEST(PointTriangle, CapSliversMatchTwin) {
   EXPECT_GT(face, 200);  // the face path of caps is exercised
 }
 
+TEST(PointTriangle, NeedlesMatchTheirKnownDistance) {
+  // Needles: a short edge 1e-2 .. 1e-14 long beside two edges about 2 long, in the plane
+  // z = offset, queried from a point of the needle raised by h (1 .. 1e-8, either side), so
+  // the distance is |h| up to the rounding of the point's in-plane coordinates (a few e*S).
+  // Their largest angle is not small, but barycentric coordinates along the needle lose about
+  // (long edge / short edge) e of accuracy: built from them, a point 1e-14 wide needle's
+  // distance came out off by up to about 1 (found by tests/fuzz/fuzz_ccd_kernel.cpp).
+  // triangle_distance() against the point as a triangle must agree.
+  std::mt19937_64 rng(14);
+  std::uniform_real_distribution<double> unit01(0.0, 1.0), sym(-1.0, 1.0);
+  double worst = 0;
+  int face = 0;
+  for (double offset : {0.0, 1e6}) {
+    for (int trial = 0; trial < 20000; ++trial) {
+      const double short_edge = std::pow(10.0, -2.0 - 12.0 * unit01(rng));
+      double xy[6];
+      for (double& x : xy) x = sym(rng);
+      const Vec3 a(offset + xy[0], offset + xy[1], offset);
+      const Vec3 b = a + Vec3(2 * xy[2], 2 * xy[3], 0);
+      const Vec3 c = b + Vec3(short_edge * xy[4], short_edge * xy[5], 0);
+      const Triangle t = {a, b, c};
+      const double w1 = unit01(rng);
+      const double w2 = unit01(rng) * (1 - w1);
+      const double h = std::pow(10.0, -8.0 * unit01(rng)) * (unit01(rng) < 0.5 ? -1 : 1);
+      Vec3 p = a + w1 * (b - a) + w2 * (c - a);
+      p.z() = offset + h;
+      const double expected = std::fabs(p.z() - offset);  // exact (Sterbenz)
+      const double unit = kEpsilon * scale_of({a, b, c, p});
+      const PointTriangleResult r = point_triangle_distance(p, t);
+      ASSERT_NEAR(std::sqrt(r.squared_distance), expected, kTolUlps * unit)
+          << "offset " << offset << " trial " << trial << " short edge " << short_edge;
+      ASSERT_NEAR(triangle_distance(t, Triangle{p, p, p}).distance, expected, kTolUlps * unit)
+          << "offset " << offset << " trial " << trial << " short edge " << short_edge;
+      worst = std::max(worst, std::fabs(std::sqrt(r.squared_distance) - expected) / unit);
+      face += r.region == PointTriangleRegion::Face;
+    }
+  }
+  std::printf("[ info ] needles: worst distance error %.2f e*S, %d Face results\n", worst, face);
+  EXPECT_GT(face, 20000);  // most points project into the needle
+}
+
 TEST(PointTriangle, Regions) {
   const Triangle t = {Vec3(0, 0, 0), Vec3(4, 0, 0), Vec3(0, 4, 0)};
   auto region = [&](const Vec3& p) { return point_triangle_distance(p, t).region; };
