@@ -7,13 +7,19 @@
 // double precision, so the primitives do touch at t*.
 //
 // What must hold, for the query and for its time reversal (start and end swapped, contact at
-// 1 - t*): the kernel reports a collision no later than the contact, and it decides it
-// before the box limit (a limit hit is conservative, but such a query is a pathology worth
-// knowing about: the first fuzzing run of the queries found one, ccd.cpp's
-// excluded_within_triangle). Without the limit check: -DVPROXQ_FUZZ_ALLOW_LIMIT.
+// 1 - t*): the kernel reports a collision no later than the contact; it decides it before the
+// box limit (a limit hit is conservative, but such a query is a pathology worth knowing about:
+// the first fuzzing run of the queries found one, ccd.cpp's excluded_within_triangle; without
+// this check: -DVPROXQ_FUZZ_ALLOW_LIMIT); and at the reported TOI the primitives are within
+// sqrt(3) ccd_max_tolerance() of each other (a hit certifies they are within δ_k on every
+// axis: the pipeline's culling margins rely on it, as CcdKernel.AReportedToiIsATimeWhenThe-
+// PrimitivesAreWithinTolerance checks on random queries).
 #include "core/geometry/ccd.hpp"
+#include "core/geometry/point_triangle.hpp"
+#include "core/geometry/segment_segment.hpp"
 #include "fuzz_support.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -39,6 +45,21 @@ void expect_found(bool vf, const Points& start, const Points& end, double contac
 #ifndef VPROXQ_FUZZ_ALLOW_LIMIT
   VPROXQ_FUZZ_CHECK(!r.hit_limit);
 #endif
+  if (r.hit_limit) return;
+  Vec3 lo = start[0], hi = start[0];
+  double magnitude = 0;
+  for (const Points* p : {&start, &end})
+    for (const Vec3& x : *p) {
+      lo = lo.cwiseMin(x);
+      hi = hi.cwiseMax(x);
+      magnitude = std::max(magnitude, x.cwiseAbs().maxCoeff());
+    }
+  const double bound = std::sqrt(3.0) * ccd_max_tolerance((hi - lo).maxCoeff(), magnitude) * (1 + 1e-6);
+  Points x;
+  for (std::size_t i = 0; i < 4; ++i) x[i] = start[i] + r.toi * (end[i] - start[i]);
+  const double d2 = vf ? point_triangle_distance(x[0], Triangle{x[1], x[2], x[3]}).squared_distance
+                       : segment_segment_distance(x[0], x[1], x[2], x[3]).squared_distance;
+  VPROXQ_FUZZ_CHECK(std::sqrt(d2) <= bound);
 }
 
 }  // namespace
