@@ -30,11 +30,7 @@ using namespace vproxq;
 
 namespace {
 
-struct Reader {
-  const std::uint8_t* data;
-  std::size_t size, at = 0;
-  std::uint8_t next() { return at < size ? data[at++] : 0; }
-};
+using Reader = fuzz::ByteReader;
 
 using Points = std::array<Vec3, 4>;
 

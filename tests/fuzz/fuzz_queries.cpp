@@ -29,11 +29,7 @@ using namespace vproxq;
 
 namespace {
 
-struct Reader {
-  const std::uint8_t* data;
-  std::size_t size, at = 0;
-  std::uint8_t next() { return at < size ? data[at++] : 0; }
-};
+using Reader = fuzz::ByteReader;
 
 double coordinate(Reader& in, double unit) {
   const std::uint8_t b = in.next();
