@@ -20,7 +20,7 @@ namespace {
 /// edge short beside two long ones: |n| ~ L times the short edge). Needles used to pass the test,
 /// made on the largest angle alone: for needles 2 long in the plane, queried from points just off
 /// them, the distance was off by up to 8e-13 with a short edge below 1e-3, 1e-8 below 1e-5 and
-/// about 1 below 1e-12 (now within 1 e*S: the test PointTriangle.NeedlesMatchTheirKnownDistance).
+/// 1.2 below 1e-13 (now within 2.4 e*S in the test PointTriangle.NeedlesMatchTheirKnownDistance).
 /// On the other path the normal is recomputed accurately (see accurate_normal) and the face
 /// candidate is the orthogonal projection onto that plane, whose distance is accurate to about
 /// e |p - corner| for any shape; the projection is also compared with all three edges. The threshold
