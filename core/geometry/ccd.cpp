@@ -67,29 +67,27 @@ inline void positions_at(const Query& q, double t, double out[4][3]) {
     for (int k = 0; k < 3; ++k) out[i][k] = q.x0[i][k] + t * q.d[i][k];
 }
 
+/// Coordinate k of F at (u, v) for the points `x` at one time, exactly as the rounding bound
+/// above assumes. Every evaluation of F goes through it (box corners, the points of a box's part
+/// inside the triangle, the earliest-face candidate), so all carry the same bound ε_k.
+inline double f_at(Kind kind, const double x[4][3], int k, double u, double v) {
+  if (kind == Kind::VertexFace) {
+    const double pa = x[0][k] - x[1][k];
+    const double ba = x[2][k] - x[1][k];
+    const double ca = x[3][k] - x[1][k];
+    return (pa - u * ba) - v * ca;
+  }
+  const double ea = x[1][k] - x[0][k];
+  const double eb = x[3][k] - x[2][k];
+  return (x[0][k] + u * ea) - (x[2][k] + v * eb);
+}
+
 /// F at the 4 (u, v) corners of a box, for the points `x` at one time; corner index bit 1 is
 /// u high, bit 2 v high (bit 0, time high, is added by the caller).
 inline void corner_values(Kind kind, const double x[4][3], const Box& b, double F[8][3], int tbit) {
-  for (int k = 0; k < 3; ++k) {
-    if (kind == Kind::VertexFace) {
-      const double pa = x[0][k] - x[1][k];
-      const double ba = x[2][k] - x[1][k];
-      const double ca = x[3][k] - x[1][k];
-      for (int c = 0; c < 4; ++c) {
-        const double u = (c & 1) ? b.u1 : b.u0;
-        const double v = (c & 2) ? b.v1 : b.v0;
-        F[tbit | (c << 1)][k] = (pa - u * ba) - v * ca;
-      }
-    } else {
-      const double ea = x[1][k] - x[0][k];
-      const double eb = x[3][k] - x[2][k];
-      for (int c = 0; c < 4; ++c) {
-        const double u = (c & 1) ? b.u1 : b.u0;
-        const double v = (c & 2) ? b.v1 : b.v0;
-        F[tbit | (c << 1)][k] = (x[0][k] + u * ea) - (x[2][k] + v * eb);
-      }
-    }
-  }
+  for (int k = 0; k < 3; ++k)
+    for (int c = 0; c < 4; ++c)
+      F[tbit | (c << 1)][k] = f_at(kind, x, k, (c & 1) ? b.u1 : b.u0, (c & 2) ? b.v1 : b.v0);
 }
 
 // ---- Exclusion along other directions ------------------------------------------------------
@@ -196,7 +194,7 @@ bool excluded_along_box_directions(const double F[8][3], const double eps[3], co
 // t, so over [t0, t1] x (that part, a polygon of at most 5 vertices) F lies in the hull of its
 // values at t0 and at t1 at the polygon's vertices. Those on the hypotenuse are (1 - v, v) or
 // (u, 1 - u) with u, v sides of the box: multiples of 2^-50, so exact. F is evaluated there as
-// corner_values() evaluates a corner (within ε_k of the exact value: the derivation above holds
+// f_at() evaluates a corner (within ε_k of the exact value: the derivation above holds
 // for any u, v in [0, 1]), and the coordinate ranges and the direction of their sum then
 // exclude the box on the same terms as its corners would.
 
@@ -235,12 +233,8 @@ bool excluded_within_triangle(const Query& q, const Box& b, const double x0[4][3
     double lo = kInfinity, hi = -kInfinity;
     for (int end = 0; end < 2; ++end) {
       const double(*x)[3] = end ? x1 : x0;
-      // The same expressions as corner_values().
-      const double pa = x[0][k] - x[1][k];
-      const double ba = x[2][k] - x[1][k];
-      const double ca = x[3][k] - x[1][k];
       for (int i = 0; i < n; ++i) {
-        const double f = (pa - uv[i][0] * ba) - uv[i][1] * ca;
+        const double f = f_at(Kind::VertexFace, x, k, uv[i][0], uv[i][1]);
         G[end * n + i][k] = f;
         lo = std::min(lo, f);
         hi = std::max(hi, f);
@@ -422,19 +416,7 @@ bool point_within_at_t0(const Query& q, const Box& b, const double x[4][3], cons
   // fl(u + v) < 1 implies u + v < 1 (rounding is monotone and 1 is a double).
   if (q.kind == Kind::VertexFace && !(u + v < 1)) return false;
   for (int k = 0; k < 3; ++k) {
-    // The same expressions as corner_values().
-    double f;
-    if (q.kind == Kind::VertexFace) {
-      const double pa = x[0][k] - x[1][k];
-      const double ba = x[2][k] - x[1][k];
-      const double ca = x[3][k] - x[1][k];
-      f = (pa - u * ba) - v * ca;
-    } else {
-      const double ea = x[1][k] - x[0][k];
-      const double eb = x[3][k] - x[2][k];
-      f = (x[0][k] + u * ea) - (x[2][k] + v * eb);
-    }
-    if (!(std::abs(f) + q.eps[k] <= q.delta[k])) return false;
+    if (!(std::abs(f_at(q.kind, x, k, u, v)) + q.eps[k] <= q.delta[k])) return false;
   }
   return true;
 }
