@@ -1,37 +1,27 @@
 #include "core/geometry/point_triangle.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 
 namespace vproxq {
 namespace {
 
-/// Smallest |n|^2 / L^4 (n the normal below, L the longest edge; |n| is twice the area) for which
-/// the plain normal and the convex-combination face candidate are used: twice the area at least
-/// 1e-3 L^2. The normal is the cross product of the two edges at the corner opposite the longest
-/// edge (the largest angle), computed in double: rounding of the edge differences and products
-/// gives it an absolute error of about 4e|e1||e2| (e = 2^-53), a direction error of about
-/// 4e/sin(angle) radians, below 5e-13 rad here. The face candidate is built from barycentric
-/// coordinates side_k / sum, where each side_k has an absolute error of about e |edge| |p - corner|
-/// |n| and sum is about |n|^2: the point is off by at most about e L^2 |p - corner| / |n| along the
-/// triangle (a crude bound: for 3.4 million needles with |n| / L^2 between 1e-3 and 1e-1, queried
-/// from points just off them, the distance was within 0.003 e*S). Two shapes fail this and take the
-/// other path: caps (nearly collinear corners, largest angle near 180 degrees) and needles (one
-/// edge short beside two long ones: |n| ~ L times the short edge). Needles used to pass the test,
-/// made on the largest angle alone: for needles 2 long in the plane, queried from points just off
-/// them, the distance was off by up to 8e-13 with a short edge below 1e-3, 1e-8 below 1e-5 and
-/// 1.2 below 1e-13 (now within 2.4 e*S in the test PointTriangle.NeedlesMatchTheirKnownDistance).
-/// On the other path the normal is recomputed accurately (see accurate_normal) and the face
-/// candidate is the orthogonal projection onto that plane, whose distance is accurate to about
-/// e |p - corner| for any shape; the projection is also compared with all three edges. The threshold
-/// only moves work between the two paths; both are accurate on their side of it.
-constexpr double kWellShapedAreaSq = 1e-6;
+/// Smallest sin of the largest angle for which a triangle has a plane: the accurate normal's
+/// error is about e|n| + 4e^2|e1||e2|, a direction error of about e + 4e^2/sin, which at
+/// sin = 4e is 2e. Flatter triangles are treated as the union of their edges; that changes the
+/// distance by at most half the triangle's width, |e1| sin / 2 < 2e|e1|.
+constexpr double kFlatSin = 4.0 * 0x1p-53;
 
-/// Smallest sin of the largest angle for which a cap's accurate normal is trusted: its error is
-/// about e|n| + 4e^2|e1||e2|, i.e. a direction error of about e + 4e^2/sin; at sin = 64e that
-/// is still ~1.06e. Flatter triangles are treated as the union of their edges; that changes the
-/// distance by at most the triangle's width, |e1| sin < 64e|e1|.
-constexpr double kFlatSin = 64.0 * 0x1p-53;
+/// The rounding bound of a side in plan_point_triangle, per |edge k| |n| |p - corner k|_2 (and
+/// so also per the larger |p - corner k|_1). side = (a x b) . n with a = fl(corner k+1 -
+/// corner k), b = fl(p - corner k): each component of a and b carries a relative error e,
+/// each product and difference of the cross product another e, so component i of a x b is off
+/// by at most 4e (|a_j b_k| + |a_k b_j|); against n (taken as exact: the side is defined by
+/// it) that sums to 4e sqrt(2) |a| |b| |n| (Cauchy-Schwarz), and the dot product adds 3e
+/// |a x b| |n| <= 3e |a| |b| |n|: 8.66e in all, to first order. 10e leaves room for the
+/// rounding of the bound itself.
+constexpr double kSideError = 10.0 * 0x1p-53;
 
 PointTriangleRegion vertex_region(int k) { return static_cast<PointTriangleRegion>(k); }
 PointTriangleRegion edge_region(int k) { return static_cast<PointTriangleRegion>(3 + k); }
@@ -85,24 +75,81 @@ PreparedTriangle prepare_triangle(const Triangle& t) {
   int longest = 0;
   if (len_sq[1] > len_sq[longest]) longest = 1;
   if (len_sq[2] > len_sq[longest]) longest = 2;
-  // The two edges meeting at the corner opposite the longest edge: its angle is the largest,
-  // so for needles (one short edge) the cross product is well conditioned.
+  // At the corner j1 opposite the longest edge (the largest angle), with the orientation of
+  // (c1-c0) x (c2-c0). A plain cross product there would be off in direction by about
+  // 4e / sin(angle): fine for most triangles, but projecting along it puts the face candidate
+  // off by that angle times the distance along the plane, and caps (largest angle near 180
+  // degrees) have sin down to 4e.
   const int j = (longest + 1) % 3;
   const int j1 = (longest + 2) % 3;
-  pt.normal = pt.edges[j].cross(pt.edges[j1]);
+  pt.normal = accurate_normal(t[j1], t[(j1 + 1) % 3], t[(j1 + 2) % 3]);
   pt.normal_sq = pt.normal.squaredNorm();
   const double edges_sq = len_sq[j] * len_sq[j1];  // |e1|^2 |e2|^2
-  pt.well_shaped = pt.normal_sq >= kWellShapedAreaSq * (len_sq[longest] * len_sq[longest]) && pt.normal_sq > 0.0;
-  if (!pt.well_shaped) {
-    // At the same corner j1 (opposite the longest edge), with the same orientation.
-    pt.normal = accurate_normal(t[j1], t[(j1 + 1) % 3], t[(j1 + 2) % 3]);
-    pt.normal_sq = pt.normal.squaredNorm();
-    if (!(pt.normal_sq >= kFlatSin * kFlatSin * edges_sq)) {
-      pt.normal_sq = 0.0;  // flat: the union of the edges
-    }
+  if (!(pt.normal_sq >= kFlatSin * kFlatSin * edges_sq)) {
+    pt.normal_sq = 0.0;  // flat: the union of the edges
+  }
+  const double normal_norm = std::sqrt(pt.normal_sq);
+  for (int k = 0; k < 3; ++k) {
+    pt.side_bound[k] = kSideError * std::sqrt(len_sq[k]) * normal_norm;
   }
   return pt;
 }
+
+namespace detail {
+
+FaceDecision decide_face(const Vec3& p, const PreparedTriangle& t, const Vec3& projection, double height) {
+  constexpr double e = 0x1p-53;
+  constexpr std::uint8_t kAllEdges = 0b111;
+  // 1. The sides again, each cross product (corner k+1 - corner k) x (p - corner k) from exact
+  // coordinate differences and compensated products (as accurate_normal: a relative error of a
+  // few e per component). What is left of a side's error is about 3e |cross| |n| from the dot
+  // product, 2e |cross| |n| from the cross product's rounding and 2e |cross| |n| from the
+  // normal's direction (the truth is the exact plane's): 8e |cross| |n| bounds it. In
+  // distance units (per |edge| |n|) that is 8e times the distance from p to the edge's line:
+  // next to nothing for p near the plane, about 8e h for p at height h above it.
+  double side[3], doubt[3];
+  bool inside = true, outside = false;
+  std::uint8_t negative = 0;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 cross = accurate_normal(t.corners[k], t.corners[(k + 1) % 3], p);
+    side[k] = cross.dot(t.normal);
+    const double bound = 8.0 * e * cross.norm() * std::sqrt(t.normal_sq);
+    inside &= side[k] > bound;
+    outside |= side[k] < -bound;
+    negative |= static_cast<std::uint8_t>(side[k] < 0.0 ? 1u << k : 0u);
+    doubt[k] = std::fabs(side[k]) > bound ? 0.0 : 2.0 * bound;  // |exact side| <= doubt
+  }
+  if (inside) return {true, 0};
+  if (outside) return {false, negative};
+  // 2. Still in doubt, with no side surely negative: a projection inside the triangle is
+  // within (doubt of side k) / (|edge k| |n|) of the line of each doubtful edge k, so within
+  // that of the boundary. A projection farther than that (plus the rounding of the computed
+  // projection and of the distances to it) from every edge is outside. This is what keeps a
+  // point past the tip of a thin needle, whose projection lies within the doubt of both long
+  // edges' lines, from being taken for inside. Otherwise the face candidate counts: if the
+  // projection is in fact outside, it is within that margin of the triangle, so the
+  // distance is off by at most the margin (a few e |p| near the plane, and only to second
+  // order, margin^2 / 2h, at height h).
+  double margin = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    margin = std::max(margin, doubt[k] / (std::sqrt(t.edges[k].squaredNorm()) * std::sqrt(t.normal_sq)));
+  }
+  double boundary_sq = kInfinity;
+  for (int k = 0; k < 3; ++k) {
+    boundary_sq = std::min(boundary_sq,
+                           point_segment_core(projection, t.corners[k], t.corners[(k + 1) % 3]).squared_distance);
+  }
+  // The projection's position: the normal's direction (2e h) and the rounding of p + offset
+  // (e per coordinate); the distances to the edges: a few e of the coordinates' magnitude.
+  const double magnitude = std::max({p.cwiseAbs().maxCoeff(), projection.cwiseAbs().maxCoeff(),
+                                     t.corners[0].cwiseAbs().maxCoeff(), t.corners[1].cwiseAbs().maxCoeff(),
+                                     t.corners[2].cwiseAbs().maxCoeff()});
+  margin += 2.0 * e * height + 8.0 * e * magnitude;
+  if (std::sqrt(boundary_sq) > margin) return {false, kAllEdges};
+  return {true, 0};
+}
+
+}  // namespace detail
 
 PointTriangleResult point_triangle_distance(const Vec3& p, const Triangle& t) {
   return point_triangle_distance(p, prepare_triangle(t));

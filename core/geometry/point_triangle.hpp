@@ -1,5 +1,7 @@
 #pragma once
 // Point-triangle distance with the closest point and the feature (vertex, edge, face) it lies on.
+#include <cmath>
+
 #include "core/geometry/segment_segment.hpp"
 #include "core/types.hpp"
 
@@ -27,24 +29,24 @@ struct PointTriangleResult {
 struct PreparedTriangle {
   Triangle corners;
   Vec3 edges[3];       ///< edges[k] = corner (k+1)%3 - corner k
-  Vec3 normal;         ///< (c1-c0) x (c2-c0), at the corner opposite the longest edge;
-                       ///< recomputed accurately when not well_shaped (point_triangle.cpp)
+  Vec3 normal;         ///< (c1-c0) x (c2-c0), computed accurately (relative error a few e) at
+                       ///< the corner opposite the longest edge (point_triangle.cpp)
   double normal_sq;    ///< |normal|^2; 0 for a flat (degenerate) triangle: the edges decide
-  bool well_shaped;    ///< |normal| >= 1e-3 (longest edge)^2: neither a cap nor a needle
+  double side_bound[3];  ///< side k's rounding bound per unit of |p - corner k|_1 (plan below)
 };
-
 /// Computes the PreparedTriangle of t.
 PreparedTriangle prepare_triangle(const Triangle& t);
 
 /// Distance from p to the closed triangle t (any shape).
 ///
-/// When the projection of p falls inside a well-shaped triangle, the closest point is that
-/// projection (region Face), built as a convex combination of the corners; otherwise it is on
-/// the edges whose inner side p is not on. A cap or a needle (twice the area below 1e-3 times
-/// the longest edge squared: nearly collinear corners, or one edge much shorter than the other
-/// two) uses an accurately computed normal and compares the projection with all three edges. A flat
-/// triangle (collinear or repeated corners, or sin < 64e) is the union of its edges: the result
-/// is the distance to the nearest edge, region Vertex or Edge. Ties go to Face, then Edge0..2.
+/// When the orthogonal projection of p onto the triangle's plane falls inside the triangle,
+/// the closest point is that projection (region Face); otherwise it is on the edges whose
+/// inner side the projection is not on. The plane's normal is computed accurately for every
+/// shape, and "inside" is decided with a rounding filter whose doubtful cases are recomputed
+/// accurately, so needles, caps and points just beside an edge are all within a few e*S (see
+/// point_triangle.cpp). A flat triangle (collinear or repeated corners, or sin < 4e) is the
+/// union of its edges: the result is the distance to the nearest edge, region Vertex or Edge.
+/// Ties go to Face, then Edge0..2.
 PointTriangleResult point_triangle_distance(const Vec3& p, const Triangle& t);
 
 /// Same as point_triangle_distance(p, t) for t = prepared.corners, bitwise.
@@ -62,40 +64,58 @@ struct PointTrianglePlan {
   std::uint8_t edge_mask;        ///< bit k: edge k (corners k, k+1) must be compared too
 };
 
-/// Branch-free on the data (the face candidate is always computed, and discarded when the
-/// projection is outside; for p in the plane of a flat configuration that may divide by zero,
-/// harmlessly); it branches only on the triangle's shape.
+/// Where the orthogonal projection of p onto t's plane lies, decided without the rounding
+/// doubt of plan_point_triangle's sides (cold path): inside (the Face candidate counts) or
+/// outside, with the edges to compare (bit k: edge k).
+struct FaceDecision {
+  bool inside;
+  std::uint8_t edge_mask;
+};
+
+/// Decides what plan_point_triangle's rounded sides could not (point_triangle.cpp).
+/// `projection` is the computed orthogonal projection of p, `height` its distance from p.
+FaceDecision decide_face(const Vec3& p, const PreparedTriangle& t, const Vec3& projection, double height);
+
+/// Branch-free on the data but for the rare doubtful sides (the face candidate is always
+/// computed, and discarded when the projection is outside); it branches on the triangle's
+/// shape.
 inline PointTrianglePlan plan_point_triangle(const Vec3& p, const PreparedTriangle& t) {
   constexpr std::uint8_t kAllEdges = 0b111;
   if (!(t.normal_sq > 0.0)) {  // flat: the union of the edges
     return {kInfinity, Vec3::Zero(), kAllEdges};
   }
+  // The face candidate: the orthogonal projection onto the plane (accurate to a few e |p - c0|
+  // with the accurate normal).
+  const Vec3 ap = p - t.corners[0];
+  const Vec3 offset = -(ap.dot(t.normal) / t.normal_sq) * t.normal;  // projection - p
+  const double face_sq = offset.squaredNorm();
   // side[k] = det(edge k, p - corner k, n): >= 0 when p projects onto the inner side of edge
   // k; it is |n| times twice the area of (corner k, corner k+1, projection of p), i.e. the
-  // unnormalised barycentric coordinate of corner k+2.
-  const Vec3 ap = p - t.corners[0];
+  // unnormalised barycentric coordinate of corner k+2. Its sign is certain when |side[k]|
+  // exceeds the rounding bound side_bound[k] |p - corner k|_1; otherwise decide_face() settles
+  // the question. A wrong sign would be no small matter: beyond the tip of a needle the
+  // projection lies within rounding of both long edges' lines while far from the triangle,
+  // and calling it inside put such points up to 0.13 too close (a needle 2 long with a tip
+  // angle of 1e-12).
+  const Vec3 bp = p - t.corners[1];
+  const Vec3 cp = p - t.corners[2];
   const double side0 = t.edges[0].cross(ap).dot(t.normal);
-  const double side1 = t.edges[1].cross(p - t.corners[1]).dot(t.normal);
-  const double side2 = t.edges[2].cross(p - t.corners[2]).dot(t.normal);
-  const double sum = side0 + side1 + side2;
-  const bool inside = (side0 >= 0.0) & (side1 >= 0.0) & (side2 >= 0.0) & (sum > 0.0);
-  if (t.well_shaped) {
-    // Closest = c0 + b1 (c1 - c0) + b2 (c2 - c0), a convex combination of the corners.
-    const double bary1 = side2 / sum;  // corner 1 is opposite edge 2
-    const double bary2 = side0 / sum;  // corner 2 is opposite edge 0
-    const Vec3 from_c0 = bary1 * t.edges[0] - bary2 * t.edges[2];
-    const double face_sq = (from_c0 - ap).squaredNorm();
-    // Outside: the closest point lies on an edge whose side is negative (one or two edges;
-    // with two, their shared corner is on both).
-    const auto outside_mask = static_cast<std::uint8_t>(
-        (side0 < 0.0 ? 1 : 0) | (side1 < 0.0 ? 2 : 0) | (side2 < 0.0 ? 4 : 0));
-    const std::uint8_t mask = inside ? std::uint8_t{0} : outside_mask != 0 ? outside_mask : kAllEdges;
-    return {select(inside, face_sq, kInfinity), t.corners[0] + from_c0, mask};
+  const double side1 = t.edges[1].cross(bp).dot(t.normal);
+  const double side2 = t.edges[2].cross(cp).dot(t.normal);
+  const bool certain0 = std::fabs(side0) > t.side_bound[0] * ap.cwiseAbs().sum();
+  const bool certain1 = std::fabs(side1) > t.side_bound[1] * bp.cwiseAbs().sum();
+  const bool certain2 = std::fabs(side2) > t.side_bound[2] * cp.cwiseAbs().sum();
+  const bool certain = certain0 & certain1 & certain2;
+  if (!certain) {
+    const FaceDecision d = decide_face(p, t, p + offset, std::sqrt(face_sq));
+    return {select(d.inside, face_sq, kInfinity), p + offset, d.edge_mask};
   }
-  // A cap (nearly collinear corners) with an accurately computed normal: the orthogonal
-  // projection onto the plane, also compared with all three edges.
-  const Vec3 offset = -(ap.dot(t.normal) / t.normal_sq) * t.normal;  // closest - p
-  return {select(inside, offset.squaredNorm(), kInfinity), p + offset, kAllEdges};
+  const bool inside = (side0 > 0.0) & (side1 > 0.0) & (side2 > 0.0);
+  // Outside, the closest point lies on an edge whose side is negative (one or two edges; with
+  // two, their shared corner is on both).
+  const auto outside_mask =
+      static_cast<std::uint8_t>((side0 < 0.0 ? 1 : 0) | (side1 < 0.0 ? 2 : 0) | (side2 < 0.0 ? 4 : 0));
+  return {select(inside, face_sq, kInfinity), p + offset, inside ? std::uint8_t{0} : outside_mask};
 }
 }  // namespace detail
 

@@ -125,7 +125,7 @@ bool point_in_projected_triangle(const Vec3& x, const Triangle& t, int axis, int
 /// which rounding can break when the segment runs along an edge line of t
 /// (segment_triangle_point() guards against that).
 Vec3 crossing_point(const Vec3& p0, const Vec3& p1, const Triangle& t) {
-  // The prepared normal is recomputed accurately for caps (nearly collinear corners).
+  // The prepared normal is computed accurately (relative error a few e), caps included.
   const Vec3 n = prepare_triangle(t).normal;
   double lo = 0.0;
   double hi = 1.0;

@@ -18,7 +18,9 @@ namespace vproxq {
 /// cut-off by more than kCpuPrefilterSlack * (grid extent). The box distance is within
 /// ~4 * 2^-53 * extent of its exact value, point_triangle_distance() is never below the exact
 /// distance by more than ~10 * 2^-53 * extent (its candidates are points of the triangle up to
-/// rounding), and the exact box distance never exceeds the exact triangle distance, so a
+/// rounding; the projection onto the plane counts where it is inside, or where rounding leaves
+/// that in doubt, within a few 2^-53 of the coordinates of the triangle: point_triangle.cpp's
+/// decide_face), and the exact box distance never exceeds the exact triangle distance, so a
 /// skipped triangle's computed distance is strictly above the cut-off: skipping it never
 /// changes the result.
 inline constexpr double kCpuPrefilterSlack = 0x1p-30;
