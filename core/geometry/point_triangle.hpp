@@ -34,6 +34,7 @@ struct PreparedTriangle {
   double normal_sq;    ///< |normal|^2; 0 for a flat (degenerate) triangle: the edges decide
   double side_bound[3];  ///< side k's rounding bound per unit of |p - corner k|_1 (plan below)
 };
+
 /// Computes the PreparedTriangle of t.
 PreparedTriangle prepare_triangle(const Triangle& t);
 

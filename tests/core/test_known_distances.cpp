@@ -22,13 +22,14 @@ TEST(SlabPairs, DistancesAndContactsMatchTheConstruction) {
     return lo + static_cast<std::int64_t>(rng.next() % static_cast<std::uint64_t>(hi - lo + 1));
   };
   int touching = 0, meeting = 0;
+  double worst = 0;  // in e*S, over the distances the construction knows
   // VPROXQ_SLAB_TRIALS=N runs N pairs instead, for a longer search (10 million: about 80 s).
   // Before the point-triangle fix of this test's commit, the first failure was pair 81,935.
   const char* env = std::getenv("VPROXQ_SLAB_TRIALS");
   const int kTrials = env != nullptr ? std::atoi(env) : 150000;
   for (int trial = 0; trial < kTrials; ++trial) {
     const test::SlabPair pair = test::make_slab_pair(pick);
-    const std::string failure = test::check_slab_pair(pair);
+    const std::string failure = test::check_slab_pair(pair, &worst);
     ASSERT_EQ(failure, "") << "trial " << trial << ": " << pair.recipe;
     std::array<test::Int2, 3> ta, tb;
     int na = 0, nb = 0;
@@ -40,8 +41,9 @@ TEST(SlabPairs, DistancesAndContactsMatchTheConstruction) {
     meeting += meet;
     touching += meet && pair.m == 0;
   }
-  std::printf("[ info ] %d slab pairs: %d at exactly the slab's width, %d of them touching\n",
-              kTrials, meeting, touching);
+  std::printf("[ info ] %d slab pairs: %d at exactly the slab's width, %d of them touching; "
+              "worst error %.2f e*S\n",
+              kTrials, meeting, touching, worst);
   // Both outcomes are common, so both kinds of check ran.
   EXPECT_GT(meeting, kTrials / 10);
   EXPECT_LT(meeting, kTrials * 9 / 10);

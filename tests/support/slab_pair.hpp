@@ -305,12 +305,16 @@ inline std::optional<long double> slab_feature_distance(const SlabPair& s, unsig
 ///     distance where slab_feature_distance knows it, at least m |n| otherwise (within the
 ///     tolerance); points as far apart as the distance says, on their sides of the slab.
 ///   - each of the 6 vertex-triangle and 9 edge-edge primitives: the same, feature by feature.
-inline std::string check_slab_pair(const SlabPair& s) {
+/// With `worst`, also raises *worst to the largest error against a known distance, in e*S.
+inline std::string check_slab_pair(const SlabPair& s, double* worst = nullptr) {
   const double tol = kSlabTolUlps * 0x1p-53 * s.scale;
   std::ostringstream fail;
   fail.precision(17);
   auto check_value = [&](const std::string& what, double d, std::optional<long double> exact) {
     const long double error = static_cast<long double>(d) - (exact ? *exact : s.gap);
+    if (exact && worst != nullptr) {
+      *worst = std::max(*worst, static_cast<double>(std::fabs(error)) / (0x1p-53 * s.scale));
+    }
     if (exact ? !(std::fabs(error) <= tol) : !(error >= -tol)) {
       fail << what << ": distance " << d << ", expected " << (exact ? "" : "at least ")
            << static_cast<double>(exact ? *exact : s.gap) << " (tolerance " << tol << ")";
