@@ -22,11 +22,12 @@ namespace {
 //    D = 2 sqrt(3) E; rounding the double distance to float (round to nearest) moves it by at
 //    most 2^-24 * D = 3.47 units;
 //  - the double distance (core/geometry/point_triangle) is exact up to a few 2^-53 * D for
-//    well-shaped triangles. Its worst case is a cap (height H << longest edge L) with the
-//    query point near its plane: the face candidate's position error is about 6 * 2^-53 * L^2
-//    / H while the edge candidates are within H / 2, so the error is at most
-//    min(H / 2, 6 * 2^-53 * L^2 / H) <= sqrt(3 * 2^-53) * L ~ 0.31 units of D (1.07 of E);
-//  - total <= 3.47 + 1.07 + (negligible 2^-53 terms) < 4.6 units; 8 leaves a wide margin.
+//    every triangle shape (an accurate normal, and no face decision from doubtful signs; the
+//    tests compare it with exactly known distances within 16 * 2^-53 of the coordinates'
+//    magnitude, at most E here): negligible in units of 2^-24 * E. (Before 95967e3 it was not:
+//    a point past the tip of a needle could come out far too close, e.g. 0.13 for a needle 2
+//    long with a tip angle of 1e-12.)
+//  - total <= 3.47 + (negligible 2^-53 terms) < 3.5 units; 8 leaves a wide margin.
 constexpr double kCpuErrorBoundUnits = 8.0;
 
 /// No site (internal): larger than every site id, so that the tie rule "smaller site id
