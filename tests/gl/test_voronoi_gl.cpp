@@ -364,7 +364,7 @@ TEST(GlVoronoi, SliversCapsAndNeedlesStayWithinTheBound) {
         const double lift = offsets[(site / 6) % 4];
         const double shift = (unit(rng) - 0.5) * length;  // where along the edge the apex is
         Triangle t;
-        switch ((site / 24) % 3) {
+        switch ((site / 24) % 4) {
           case 0:  // cap (or flat): q projects inside, near the centroid
             t = {at(-0.5 * length, -height / 3, lift), at(0.5 * length, -height / 3, lift),
                  at(shift, 2 * height / 3, lift)};
@@ -373,10 +373,17 @@ TEST(GlVoronoi, SliversCapsAndNeedlesStayWithinTheBound) {
             t = {at(-0.5 * length, 1e-6, lift), at(0.5 * length, 1e-6, lift),
                  at(shift, 1e-6 + height, lift)};
             break;
-          default:  // needle: two corners 'height' apart, the third far
+          case 2:  // needle: two corners 'height' apart, the third far
             t = {at(-0.5 * length, -0.1, lift), at(-0.5 * length + height, -0.1, lift),
                  at(0.5 * length, 0.2, lift)};
             break;
+          default: {  // q past the tip of a needle 'height' wide, on its axis: within rounding
+                      // of both long edges' lines (the case point_triangle.cpp's decide_face
+                      // exists for), the tip 1e-6 .. 0.5 away
+            const double gap = std::pow(10.0, -6.0 + 5.7 * unit(rng));
+            t = {at(gap, 0.0, lift), at(gap + length, -0.5 * height, lift), at(gap + length, 0.5 * height, lift)};
+            break;
+          }
         }
         add_triangle(in, t, site++);
         in.voxels.push_back(id);
