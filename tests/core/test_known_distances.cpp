@@ -31,13 +31,7 @@ TEST(SlabPairs, DistancesAndContactsMatchTheConstruction) {
     const test::SlabPair pair = test::make_slab_pair(pick);
     const std::string failure = test::check_slab_pair(pair, &worst);
     ASSERT_EQ(failure, "") << "trial " << trial << ": " << pair.recipe;
-    std::array<test::Int2, 3> ta, tb;
-    int na = 0, nb = 0;
-    for (std::size_t c = 0; c < 3; ++c) {
-      if (pair.top_a[c]) ta[static_cast<std::size_t>(na++)] = pair.xy_a[c];
-      if (pair.top_b[c]) tb[static_cast<std::size_t>(nb++)] = pair.xy_b[c];
-    }
-    const bool meet = test::hulls_meet(ta.data(), na, tb.data(), nb);
+    const bool meet = test::top_features_meet(pair);
     meeting += meet;
     touching += meet && pair.m == 0;
   }
