@@ -30,6 +30,11 @@ const fs::path& scratch_dir() {
 }
 
 void write_file(const fs::path& file, const void* data, std::size_t size) {
+  // A new file, not the old one truncated: ext4 flushes a truncated file to disk when it is
+  // closed (auto_da_alloc), which made every input wait for the disk (4,000 fuzz_result_diff
+  // inputs: 2 to 5 s before, 0.5 s now).
+  std::error_code ec;
+  fs::remove(file, ec);
   std::ofstream out(file, std::ios::binary | std::ios::trunc);
   out.write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
   if (!out) {
