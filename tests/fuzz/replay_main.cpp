@@ -32,6 +32,8 @@
 #include <string_view>
 #include <vector>
 
+#include "support/rng.hpp"
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
 // Weak: most harnesses have none (the pointer is then null).
 extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) __attribute__((weak));
@@ -149,16 +151,11 @@ void install_signal_handlers() {
 
 // ---- Deterministic generation ------------------------------------------------------------------
 
-/// splitmix64: the same numbers with every compiler and library (unlike <random>'s
-/// distributions).
+/// The suite's generator (tests/support/rng.hpp: the same numbers with every compiler and
+/// library, unlike <random>'s distributions), with the draws the mutations use.
 struct Rng {
-  std::uint64_t state;
-  std::uint64_t next() {
-    std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-  }
+  vproxq::test::Rng bits;
+  std::uint64_t next() { return bits.next(); }
   /// Uniform in [0, n) (0 for n = 0); the bias is irrelevant here.
   std::size_t below(std::size_t n) { return n == 0 ? 0 : static_cast<std::size_t>(next() % n); }
   bool one_in(std::size_t n) { return below(n) == 0; }
@@ -316,7 +313,7 @@ struct Generator {
 
   /// Generated input i: a fresh generator for each, so that any one can be made alone.
   Bytes operator()(std::uint64_t i) const {
-    Rng rng{Rng{seed}.next() ^ i};
+    Rng rng{vproxq::test::Rng(vproxq::test::Rng(seed).next() ^ i)};
     // Without seeds, or one time in 16: random bytes.
     if (seeds.empty() || rng.one_in(16)) return random_bytes(max_len, rng);
     if (join < 0) return mutant(seeds, rng);
