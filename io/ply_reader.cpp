@@ -208,6 +208,10 @@ class BinaryCursor {
 
   std::size_t remaining() const { return static_cast<std::size_t>(end_ - p_); }
 
+  /// Records have no boundaries in binary: their size is what the types say.
+  void begin_record() {}
+  void end_record() {}
+
   /// Throws unless every byte was read: bytes past the header's counts mean the counts or the
   /// types do not describe the file (as values past them do in ascii).
   void expect_end() const {
@@ -282,6 +286,28 @@ class AsciiCursor {
 
   std::size_t remaining() const { return static_cast<std::size_t>(end_ - p_); }
 
+  /// In ascii every record is one line (blank lines between records are allowed): a line with
+  /// fewer or more values than the element's properties take means the header does not describe
+  /// the data (say, vertex rows carrying normals that the header leaves out). Read as one stream
+  /// of values, such a file failed far from the cause or, when a longer row and a shorter one
+  /// made up for each other, read with wrong coordinates and no error.
+  void begin_record() {
+    skip_blank(true);
+    in_record_ = true;
+  }
+  void end_record() {
+    skip_blank(false);
+    in_record_ = false;
+    if (p_ == end_ || *p_ == '\n') return;
+    const char* b = p_;
+    while (p_ < end_ && !is_space_or_newline(*p_)) ++p_;
+    throw_input_error(*where_.file, "line " + std::to_string(line_) + ": more values than the header declares for " +
+                                        where_.record_text() + ": '" +
+                                        abbreviate(std::string_view(b, static_cast<std::size_t>(p_ - b))) +
+                                        "' after its last property (each record is one line; does the header "
+                                        "list every property of the data?)");
+  }
+
   /// Throws unless only whitespace is left: values past the header's counts mean the counts
   /// do not describe the file.
   void expect_end() {
@@ -321,10 +347,20 @@ class AsciiCursor {
   }
 
  private:
-  std::string_view token() {
-    while (p_ < end_ && is_space_or_newline(*p_)) {
+  /// Skips whitespace, and line ends too when `newlines` (else stops at one).
+  void skip_blank(bool newlines) {
+    while (p_ < end_ && is_space_or_newline(*p_) && (newlines || *p_ != '\n')) {
       if (*p_ == '\n') ++line_;
       ++p_;
+    }
+  }
+  std::string_view token() {
+    skip_blank(!in_record_);
+    if (p_ < end_ && *p_ == '\n') {
+      throw_input_error(*where_.file, "line " + std::to_string(line_) + ": fewer values than the header declares for " +
+                                          where_.record_text() +
+                                          ": the line ends before its last property (each record is one line; "
+                                          "does the header match the data?)");
     }
     if (p_ == end_) {
       throw_input_error(*where_.file, "unexpected end of file inside " + where_.record_text());
@@ -343,6 +379,7 @@ class AsciiCursor {
   const char* end_;
   long line_;
   const Where& where_;
+  bool in_record_ = false;
 };
 
 int find_property(const Element& e, std::string_view name) {
@@ -435,6 +472,7 @@ void read_body(const fs::path& file, const Header& h, Cursor& in, Where& where, 
       for (int a = 0; a < 3; ++a) axis_prop[a] = find_property(e, axis_name(a));
       out.positions.reserve(reservable);
       for (where.record = 0; where.record < e.count; ++where.record) {
+        in.begin_record();
         Vec3 p = Vec3::Zero();
         for (std::size_t i = 0; i < e.props.size(); ++i) {
           const Property& prop = e.props[i];
@@ -453,6 +491,7 @@ void read_body(const fs::path& file, const Header& h, Cursor& in, Where& where, 
             in.skip(prop.type);
           }
         }
+        in.end_record();
         if (const std::string problem = coordinate_problem(p); !problem.empty())
           throw_input_error(file, "vertex " + std::to_string(where.record) + " (0-based) " + problem);
         out.positions.push_back(p);
@@ -461,6 +500,7 @@ void read_body(const fs::path& file, const Header& h, Cursor& in, Where& where, 
       const int list = face_list_property(e);
       out.faces.reserve(reservable);
       for (where.record = 0; where.record < e.count; ++where.record) {
+        in.begin_record();
         for (std::size_t i = 0; i < e.props.size(); ++i) {
           const Property& prop = e.props[i];
           if (static_cast<int>(i) != list) {
@@ -491,9 +531,13 @@ void read_body(const fs::path& file, const Header& h, Cursor& in, Where& where, 
             out.faces.push_back({corners[0], corners[c], corners[c + 1]});
           }
         }
+        in.end_record();
       }
     } else {
+      // An element without properties has empty records: no line of its own to look for.
+      if (e.props.empty()) continue;
       for (where.record = 0; where.record < e.count; ++where.record) {
+        in.begin_record();
         for (const Property& prop : e.props) {
           if (prop.is_list) {
             in.skip(prop.type, in.integer(prop.count_type));
@@ -501,6 +545,7 @@ void read_body(const fs::path& file, const Header& h, Cursor& in, Where& where, 
             in.skip(prop.type);
           }
         }
+        in.end_record();
       }
     }
   }

@@ -46,7 +46,8 @@ TEST(PlyReader, AsciiWithExtraPropertiesAndElements) {
                               "1 0 1 0 1 7\n"
                               "0 0 1 0 0\n"
                               "9 4 0 1 2 3 0\n"
-                              "9\n3 3 2 1 1 42\n"  // records may span lines
+                              "\n"  // blank lines between records are fine
+                              "9 3 3 2 1 1 42\n"
                               "0 1\n");
   const auto groups = read_mesh_file(file);
   ASSERT_EQ(groups.size(), 1u);
@@ -297,7 +298,7 @@ TEST(PlyReaderErrors, TruncatedBinaryData) {
 TEST(PlyReaderErrors, AsciiDataProblems) {
   TempDir dir;
   const auto eof =
-      dir.write("eof.ply", ascii_header(kXyz, kFaces + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n"));
+      dir.write("eof.ply", ascii_header(kXyz, kFaces + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1"));
   EXPECT_INPUT_ERROR(read_mesh_file(eof), eof.string() + ": unexpected end of file",
                      "element 'face' record 0 (0-based) of 1");
   const auto bad = dir.write(
@@ -315,6 +316,42 @@ TEST(PlyReaderErrors, AsciiDataProblems) {
   const auto space = dir.write(
       "space.ply", ascii_header(kXyz, kFaces + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n\n  \n"));
   EXPECT_EQ(read_mesh_file(space)[0].faces.size(), 1u);
+}
+
+// Each ascii record is one line (as Greg Turk's reference reader reads them): a row with more
+// or fewer values than the header's properties is an error at that line, not a stream of values
+// read on into the next record.
+TEST(PlyReaderErrors, AsciiRecordsAreLines) {
+  TempDir dir;
+  // Vertex rows that carry normals the header does not declare: the error names the row.
+  const auto normals = dir.write(
+      "normals.ply", ascii_header(kXyz, kFaces + "end_header\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n"));
+  EXPECT_INPUT_ERROR(read_mesh_file(normals), normals.string() + ": line 10: more values than the header declares",
+                     "element 'vertex' record 0 (0-based) of 3: '0' after its last property");
+  // A long row and a short one that make up for each other: read as a stream, vertex 2 came out
+  // as (0.5, 0, 1) without a word.
+  const auto silent = dir.write(
+      "silent.ply", ascii_header(kXyz, kFaces + "end_header\n0 0 0\n1 0 0 0.5\n0 1\n3 0 1 2\n"));
+  EXPECT_INPUT_ERROR(read_mesh_file(silent), silent.string() + ": line 11: more values than the header declares",
+                     "element 'vertex' record 1 (0-based) of 3: '0.5'");
+  // A short row alone.
+  const auto short_row = dir.write(
+      "short.ply", ascii_header(kXyz, kFaces + "end_header\n0 0 0\n1 0\n0 1 0\n3 0 1 2\n"));
+  EXPECT_INPUT_ERROR(read_mesh_file(short_row), short_row.string() + ": line 11: fewer values than the header declares",
+                     "element 'vertex' record 1 (0-based) of 3");
+  // A face whose list is longer or shorter than its count says.
+  const auto long_face = dir.write(
+      "long_face.ply", ascii_header(kXyz, kFaces + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 0\n"));
+  EXPECT_INPUT_ERROR(read_mesh_file(long_face), long_face.string() + ": line 13: more values than the header declares",
+                     "element 'face' record 0 (0-based) of 1");
+  const auto split_face = dir.write(
+      "split_face.ply", ascii_header(kXyz, kFaces + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n2\n"));
+  EXPECT_INPUT_ERROR(read_mesh_file(split_face), split_face.string() + ": line 13: fewer values than the header declares",
+                     "element 'face' record 0 (0-based) of 1");
+  // Spaces, tabs and CR before the line end are whitespace, not values.
+  const auto crlf = dir.write(
+      "crlf.ply", ascii_header(kXyz, kFaces + "end_header\r\n0 0 0 \t\r\n1 0 0\r\n\r\n0 1 0\r\n3 0 1 2\r\n"));
+  EXPECT_EQ(read_mesh_file(crlf)[0].positions.size(), 3u);
 }
 
 // Binary data past the header's counts: as in ascii, the counts (or the property types) do not
