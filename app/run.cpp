@@ -220,7 +220,8 @@ void run_intra(const Frame& frame, const FrameBoxes& boxes, VoronoiStage& vorono
 }  // namespace
 
 void run(const Config& config) {
-  const SceneSource scene = SceneSource::open(config.scene_path);
+  // The frame files are checked once the range is known: only those the run reads need exist.
+  const SceneSource scene = SceneSource::open(config.scene_path, FrameFileCheck::Deferred);
 
   std::vector<std::string> queries =
       !config.queries.empty() ? canonical_queries(config.queries, "--queries")
@@ -234,6 +235,14 @@ void run(const Config& config) {
   if (first >= count)
     throw UsageError("--frames: first frame " + std::to_string(first) + " is past the end (" +
                      config.scene_path + " has " + std::to_string(count) + (count == 1 ? " frame)" : " frames)"));
+
+  const bool want_distance = std::find(queries.begin(), queries.end(), "distance") != queries.end();
+  const bool want_pd = std::find(queries.begin(), queries.end(), "pd") != queries.end();
+  const bool want_ccd = std::find(queries.begin(), queries.end(), "ccd") != queries.end();
+  // The frames the run reads: first .. last-1, and frame last too with CCD when the scene has
+  // it (CCD of frame k covers the step k -> k+1, also past the end of --frames).
+  const long read_end = want_ccd ? std::min(last + 1, count) : last;
+  scene.require_frames(static_cast<std::size_t>(first), static_cast<std::size_t>(read_end));
 
   RunInfo info;
   info.scene = config.scene_path;
@@ -258,15 +267,9 @@ void run(const Config& config) {
   if (!config.output_dir.empty())
     writer = std::make_unique<BackgroundWriter>(std::make_unique<ResultWriter>(config.output_dir, info), inline_ms);
 
-  const bool want_distance = std::find(queries.begin(), queries.end(), "distance") != queries.end();
-  const bool want_pd = std::find(queries.begin(), queries.end(), "pd") != queries.end();
-  const bool want_ccd = std::find(queries.begin(), queries.end(), "ccd") != queries.end();
-  // CCD of frame k covers the step k -> k+1 whenever the scene has frame k+1 (also past the
-  // end of --frames); that frame is loaded once and reused as the next frame of the loop.
+  // The next frame of a CCD step is loaded once and reused as the next frame of the loop.
   // Frames are read in order, each on a background thread while the one before it is in use
-  // (see above; in line when reads are quick; `load` is the time the loop waited for them):
-  // frames first .. last-1, and frame last too with CCD when the scene has it.
-  const long read_end = want_ccd ? std::min(last + 1, count) : last;
+  // (see above; in line when reads are quick; `load` is the time the loop waited for them).
   FrameReadAhead reader(scene, static_cast<std::size_t>(first), static_cast<std::size_t>(read_end), inline_ms);
   std::optional<Frame> next_frame;
   StaticIntraCache static_intra;

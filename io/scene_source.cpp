@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <iterator>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string_view>
@@ -24,13 +25,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
-
-/// One sequence of frame files: the scene's (one file per frame, all objects), or one
-/// object's (per-object sequences).
-struct Sequence {
-  std::string object_name;      ///< per-object sequences only
-  std::vector<fs::path> files;  ///< resolved against the scene file's folder
-};
 
 std::size_t edit_distance(std::string_view a, std::string_view b) {
   std::vector<std::size_t> row(b.size() + 1);
@@ -62,6 +56,28 @@ struct FramePattern {
     std::snprintf(buf, sizeof buf, conversion.c_str(), value);
     return prefix + buf + suffix;
   }
+};
+
+/// One sequence of frame files: the scene's (one file per frame, all objects), or one
+/// object's (per-object sequences). A pattern's file names are made when asked for, so that a
+/// large "count" costs nothing until its frames are read.
+struct Sequence {
+  std::string object_name;            ///< per-object sequences only
+  std::vector<fs::path> files;        ///< a "files" list, or a bare mesh file (no pattern)
+  std::optional<FramePattern> pattern;  ///< frame k: `base` / pattern->format(first + k)
+  fs::path base;                      ///< the scene file's folder
+  long long first = 0;
+  std::size_t count = 0;              ///< with a pattern
+  /// The scene.json key that lists the files ("frames.pattern", or "frames.files" whose items
+  /// are named "frames.files[i]"), for messages about one of them; empty for a bare mesh file.
+  std::string key;
+  bool indexed = false;  ///< the files are a "files" list (their key takes the index)
+
+  std::size_t size() const { return pattern ? count : files.size(); }
+  fs::path file(std::size_t k) const {
+    return pattern ? base / pattern->format(static_cast<int>(first + static_cast<long long>(k))) : files[k];
+  }
+  std::string key_of(std::size_t i) const { return indexed ? key + "[" + std::to_string(i) + "]" : key; }
 };
 
 /// Parses `pattern`; on error returns false and sets `why`.
@@ -188,8 +204,9 @@ class SceneParser {
 
   fs::path resolve(const std::string& relative) const { return base_ / relative; }
 
-  /// A "frames" object: {"pattern", "first", "count"} or {"files"}. Checks every file exists.
-  std::vector<fs::path> frames(const json& j, const std::string& key) const {
+  /// A "frames" object: {"pattern", "first", "count"} or {"files"}. Whether the files exist is
+  /// checked later (require_file(), for the frames a run reads).
+  Sequence frames(const json& j, const std::string& key) const {
     if (!j.is_object()) {
       fail(key,
            "must be an object with \"pattern\", \"first\" and \"count\", or with "
@@ -197,7 +214,7 @@ class SceneParser {
                shown(j));
     }
     check_keys(j, key + ".", {"pattern", "first", "count", "files"});
-    std::vector<fs::path> files;
+    Sequence seq;
     if (j.contains("files")) {
       for (const char* other : {"pattern", "first", "count"}) {
         if (j.contains(other))
@@ -209,12 +226,11 @@ class SceneParser {
       if (!list.is_array() || list.empty()) {
         fail(fkey, "must be a non-empty array of file names, got " + shown(list));
       }
-      for (std::size_t i = 0; i < list.size(); ++i) {
-        const std::string ikey = fkey + "[" + std::to_string(i) + "]";
-        files.push_back(resolve(string(list[i], ikey)));
-        require_file(files.back(), ikey, i);
-      }
-      return files;
+      for (std::size_t i = 0; i < list.size(); ++i)
+        seq.files.push_back(resolve(string(list[i], fkey + "[" + std::to_string(i) + "]")));
+      seq.key = fkey;
+      seq.indexed = true;
+      return seq;
     }
     if (!j.contains("pattern") || !j.contains("count")) {
       fail(key, "needs either \"pattern\" and \"count\" (and optionally \"first\"), or \"files\"");
@@ -233,11 +249,12 @@ class SceneParser {
                                in_quotes(key + ".count") + " exceeds the largest frame number " +
                                std::to_string(INT_MAX));
     }
-    for (long long n = first; n < first + count; ++n) {
-      files.push_back(resolve(fp.format(static_cast<int>(n))));
-      require_file(files.back(), key + ".pattern", static_cast<std::size_t>(n - first));
-    }
-    return files;
+    seq.pattern = fp;
+    seq.base = base_;
+    seq.first = first;
+    seq.count = static_cast<std::size_t>(count);
+    seq.key = key + ".pattern";
+    return seq;
   }
 
   void require_file(const fs::path& file, const std::string& key, std::size_t position) const {
@@ -371,24 +388,22 @@ void parse_scene_json(SceneImpl& s) {
       p.check_keys(o, key + ".", {"name", "frames"});
       if (!o.contains("name")) p.fail(key + ".name", "is missing");
       if (!o.contains("frames")) p.fail(key + ".frames", "is missing");
-      Sequence seq;
-      seq.object_name = p.string(o["name"], key + ".name");
-      seq.files = p.frames(o["frames"], key + ".frames");
-      if (i > 0 && seq.files.size() != s.sequences[0].files.size()) {
-        p.fail(key + ".frames", "has " + std::to_string(seq.files.size()) +
+      const std::string name = p.string(o["name"], key + ".name");
+      Sequence seq = p.frames(o["frames"], key + ".frames");
+      seq.object_name = name;
+      if (i > 0 && seq.size() != s.sequences[0].size()) {
+        p.fail(key + ".frames", "has " + std::to_string(seq.size()) +
                                     " frames, but \"objects[0].frames\" has " +
-                                    std::to_string(s.sequences[0].files.size()) +
+                                    std::to_string(s.sequences[0].size()) +
                                     " (every object needs the same number of frames)");
       }
       s.sequences.push_back(std::move(seq));
     }
   } else {
     if (!root.contains("frames")) p.fail("frames", "is missing");
-    Sequence seq;
-    seq.files = p.frames(root["frames"], "frames");
-    s.sequences.push_back(std::move(seq));
+    s.sequences.push_back(p.frames(root["frames"], "frames"));
   }
-  s.frame_count = s.sequences[0].files.size();
+  s.frame_count = s.sequences[0].size();
 
   if (root.contains("queries")) {
     const json& q = root["queries"];
@@ -443,19 +458,23 @@ void parse_scene_json(SceneImpl& s) {
 
 }  // namespace
 
-SceneSource SceneSource::open(const fs::path& path) {
+SceneSource SceneSource::open(const fs::path& path, FrameFileCheck check) {
   auto impl = std::make_unique<Impl>();
   impl->path = path;
-  if (io_detail::lower_extension(path) == ".json") {
-    parse_scene_json(*impl);
-  } else {
+  if (io_detail::lower_extension(path) != ".json") {
     // A bare mesh file: a one-frame scene, one object per mesh.
     io_detail::require_regular_file(path);
     impl->name = path.stem().string();
-    impl->sequences.push_back(Sequence{std::string(), {path}});
+    Sequence seq;
+    seq.files = {path};
+    impl->sequences.push_back(std::move(seq));
     impl->frame_count = 1;
+    return SceneSource(std::move(impl));
   }
-  return SceneSource(std::move(impl));
+  parse_scene_json(*impl);
+  SceneSource scene(std::move(impl));
+  if (check == FrameFileCheck::All) scene.require_frames(0, scene.frame_count());
+  return scene;
 }
 
 Frame SceneSource::load_frame(std::size_t k) const {
@@ -468,7 +487,7 @@ Frame SceneSource::load_frame(std::size_t k) const {
   frame.index = static_cast<int>(k);
   std::vector<MeshGroup> parts;
   if (!s.per_object) {
-    const fs::path& file = s.sequences[0].files[k];
+    const fs::path file = s.sequences[0].file(k);
     frame.files.push_back(file.string());
     std::vector<MeshGroup> groups = read_mesh_file(file);
     if (count_faces(groups) == 0) {
@@ -478,7 +497,7 @@ Frame SceneSource::load_frame(std::size_t k) const {
   } else {
     // Each file is one object, whatever groups it holds; its vertices keep file order.
     for (const Sequence& seq : s.sequences) {
-      const fs::path& file = seq.files[k];
+      const fs::path file = seq.file(k);
       frame.files.push_back(file.string());
       MeshGroup g = io_detail::read_mesh_file_merged(file);
       if (g.faces.empty()) {
@@ -542,6 +561,16 @@ SceneSource::~SceneSource() = default;
 const std::string& SceneSource::name() const { return impl_->name; }
 const fs::path& SceneSource::path() const { return impl_->path; }
 std::size_t SceneSource::frame_count() const { return impl_->frame_count; }
+
+void SceneSource::require_frames(std::size_t first, std::size_t last) const {
+  const Impl& s = *impl_;
+  last = std::min(last, s.frame_count);
+  const SceneParser p(s.path);
+  for (const Sequence& seq : s.sequences) {
+    if (seq.key.empty()) continue;  // a bare mesh file, checked by open()
+    for (std::size_t k = first; k < last; ++k) p.require_file(seq.file(k), seq.key_of(k), k);
+  }
+}
 const std::vector<std::string>& SceneSource::queries() const { return impl_->queries; }
 std::optional<int> SceneSource::grid() const { return impl_->grid; }
 ObjectSplit SceneSource::split() const { return impl_->split; }

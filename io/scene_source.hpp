@@ -28,14 +28,25 @@ enum class ObjectSplit { Meshes, Components };
 /// gigabytes on small scenes.
 inline constexpr int kMaxGridResolution = 4096;
 
+/// Which frame files SceneSource::open() checks: all of them, or none (the caller checks the
+/// ones it will read with require_frames(), so that a run over the first frames of a sequence
+/// still being written does not fail on the frames not written yet).
+enum class FrameFileCheck { All, Deferred };
+
 /// A parsed scene. Frames are read from disk only in load_frame(), so memory does not grow
 /// with the number of frames. Static geometry is read once and shared by every frame.
 class SceneSource {
  public:
   /// Opens a scene.json, or a bare mesh file (.obj, .ply, or anything assimp reads) as a
-  /// one-frame scene. Checks the whole description and that every frame file exists.
+  /// one-frame scene. Checks the whole description, reads the static files, and checks that
+  /// every frame file exists (`check` All) or none (Deferred: see require_frames()).
   /// Throws InputError naming the file and, for scene.json, the key and why it is wrong.
-  static SceneSource open(const std::filesystem::path& path);
+  static SceneSource open(const std::filesystem::path& path, FrameFileCheck check = FrameFileCheck::All);
+
+  /// Checks that the frame files of positions [first, last) exist and are regular files
+  /// (last is capped at frame_count()); throws InputError naming scene.json, the key that
+  /// lists the file, the frame and the file, as open() does with FrameFileCheck::All.
+  void require_frames(std::size_t first, std::size_t last) const;
 
   const std::string& name() const;
   const std::filesystem::path& path() const;

@@ -256,6 +256,36 @@ TEST(Cli, ABadFrameFailsOnlyARunThatNeedsIt) {
   }
 }
 
+// A frame file that does not exist (yet: a simulation still writing its frames) fails only a run
+// that reads it, as a bad one does: --frames 0:2 needs frames 0 and 1, and with CCD frame 2 too.
+// The message names scene.json, the key, the frame and the file; nothing is written.
+TEST(Cli, AMissingFrameFileFailsOnlyARunThatReadsIt) {
+  ScratchDir dir;
+  const std::string mesh = "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no b\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf 4 5 6\n";
+  dir.write("f_0.obj", mesh);
+  dir.write("f_1.obj", mesh);
+  for (const std::string frames : {R"({"pattern": "f_%d.obj", "count": 4})", R"({"files": ["f_0.obj", "f_1.obj", "f_2.obj", "f_3.obj"]})"}) {
+    SCOPED_TRACE(frames);
+    const auto scene = dir.write("scene.json", R"({"frames": )" + frames + "}");
+    const auto out = dir / "out";
+    auto r = vproxq(quote(scene) + " --frames 0:2 -o " + quote(out) + " --quiet");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(read_json(out / "results.json")["frames"].size(), 2u);
+    fs::remove_all(out);
+    r = vproxq(quote(scene) + " --frames 1 --queries distance,ccd -o " + quote(out) + " --quiet");
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    const std::string key = frames.find("pattern") != std::string::npos ? "\"frames.pattern\"" : "\"frames.files[2]\"";
+    EXPECT_NE(r.output.find(scene.string() + ": " + key + " frame 2: file not found: "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("f_2.obj"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out)) << r.output;
+    // All frames (the default range), without -o: the error, and nothing on stdout.
+    r = test::run_command("{ " + std::string(VPROXQ_BINARY) + " " + quote(scene) + " > " + quote(dir / "stdout.txt") + "; }");
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    EXPECT_NE(r.output.find("frame 2: file not found"), std::string::npos) << r.output;
+    EXPECT_EQ(slurp(dir / "stdout.txt"), "");
+  }
+}
+
 // A run ended by SIGTERM or SIGHUP (a timeout, a closed terminal; SIGINT is handled the same
 // way, but a shell starts background jobs with it ignored) removes its temporary files and the
 // directories it created, then ends by that signal. The run is a slow one (a very fine grid on

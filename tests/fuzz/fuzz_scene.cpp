@@ -1,7 +1,8 @@
 // Each input is a scene.json beside a few small mesh files of the harness's own (a.obj, two
-// objects; frames/f_0000.obj to f_0002.obj, the same moving; b.ply, one triangle): opening it
-// and loading up to 4 of its frames either throws InputError or succeeds. Seeds: the sample
-// scenes' scene.json files, and scenes that name these files, e.g.
+// objects; frames/f_0000.obj to f_0002.obj, the same moving; b.ply, one triangle): opening it,
+// checking its first 4 frame files as the CLI checks them, and loading those frames either
+// throws InputError or succeeds. Seeds: the sample scenes' scene.json files, and scenes that
+// name these files, e.g.
 //   {"frames": {"pattern": "frames/f_%04d.obj", "first": 0, "count": 3}, "static": ["b.ply"]}
 #include "core/errors.hpp"
 #include "fuzz_support.hpp"
@@ -42,7 +43,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto file = fuzz::scratch_dir() / "scene.json";
   fuzz::write_file(file, data, size);
   try {
-    const SceneSource scene = SceneSource::open(file);
+    // As the CLI opens it: the frame files are checked for the frames read.
+    const SceneSource scene = SceneSource::open(file, FrameFileCheck::Deferred);
+    scene.require_frames(0, 4);
     for (std::size_t k = 0; k < scene.frame_count() && k < 4; ++k) {
       const Frame frame = scene.load_frame(k);
       for (const Object& o : frame.objects)

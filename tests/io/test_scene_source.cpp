@@ -74,6 +74,33 @@ TEST_F(SceneSourceTest, PatternFramesLoadOnRequest) {
   EXPECT_NE(f2.objects[0].topology.get(), f2.objects[1].topology.get());
 }
 
+// FrameFileCheck::Deferred: open() checks no frame file, require_frames() the ones asked for,
+// with open()'s message; a huge "count" costs nothing (file names are made when asked for).
+TEST_F(SceneSourceTest, DeferredFrameChecksCoverOnlyTheFramesAskedFor) {
+  dir.write("f_0.obj", triangles_obj({"a"}));
+  dir.write("f_1.obj", triangles_obj({"a"}, 1));
+  for (const std::string& per_object : {std::string("0"), std::string("1")}) {
+    SCOPED_TRACE(per_object);
+    const std::string frames = R"({"pattern": "f_%d.obj", "count": 2147483647})";
+    const auto path = scene(per_object == "1" ? R"({"objects": [{"name": "a", "frames": )" + frames + "}]}"
+                                              : R"({"frames": )" + frames + "}");
+    const std::string key = per_object == "1" ? "\"objects[0].frames.pattern\"" : "\"frames.pattern\"";
+    EXPECT_INPUT_ERROR(SceneSource::open(path), path.string() + ": " + key + " frame 2: file not found: ",
+                       (dir.path() / "f_2.obj").string());
+    const SceneSource s = SceneSource::open(path, FrameFileCheck::Deferred);
+    EXPECT_EQ(s.frame_count(), 2147483647u);
+    s.require_frames(0, 2);
+    s.require_frames(1, 1);
+    EXPECT_EQ(s.load_frame(1).objects[0].positions[0], Vec3(1, 0, 0));
+    EXPECT_INPUT_ERROR(s.require_frames(1, 3), path.string() + ": " + key + " frame 2: file not found: ");
+    EXPECT_INPUT_ERROR(s.load_frame(5), (dir.path() / "f_5.obj").string() + ": file not found");
+  }
+  const auto listed = scene(R"({"frames": {"files": ["f_0.obj", "gone.obj", "f_1.obj"]}})");
+  const SceneSource s = SceneSource::open(listed, FrameFileCheck::Deferred);
+  s.require_frames(2, 3);
+  EXPECT_INPUT_ERROR(s.require_frames(0, 3), listed.string() + ": \"frames.files[1]\" frame 1: file not found: ");
+}
+
 // FrameReadAhead hands out frames first .. end-1 in order, as load_frame() gives them (the
 // topologies of unchanged faces shared, which needs the reads in order), and a frame's read
 // error only when that frame is asked for: the frames before it come back whole even when its
