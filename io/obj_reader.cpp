@@ -154,8 +154,16 @@ class ObjParser {
     if (kw == "v") return parse_vertex(rest);
     if (kw == "f") return parse_face(rest);
     if (kw == "o" || kw == "g") {
+      // The name ends where a comment starts: at a word that begins with '#', as on v and f
+      // lines ("o cloth  # the skirt" names "cloth"); a '#' inside a word is part of the name.
+      std::string_view name = rest;
+      for (std::size_t i = 0; i < name.size(); ++i)
+        if (name[i] == '#' && (i == 0 || is_space(name[i - 1]))) {
+          name = name.substr(0, i);
+          break;
+        }
       groups_.emplace_back();
-      groups_.back().name = std::string(trim(rest));
+      groups_.back().name = std::string(trim(name));
       return;
     }
     if (std::find(kIgnoredStatements.begin(), kIgnoredStatements.end(), kw) !=

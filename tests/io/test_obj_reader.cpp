@@ -156,6 +156,25 @@ TEST(ObjReader, UnnamedGroupsAreNamedAfterTheFileStem) {
   EXPECT_EQ(groups[1].faces, faces({{0, 1, 2}}));
 }
 
+// A comment after a group name is not part of it (as after v and f values): the name ends at
+// a word that starts with '#'; a '#' inside a word stays in the name.
+TEST(ObjReader, GroupNamesEndWhereACommentStarts) {
+  TempDir dir;
+  const auto file = dir.write("comments.obj",
+                              "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                              "o cloth   # the skirt\n"
+                              "f 1 2 3 # first\n"
+                              "g part#2 left\t#note\n"
+                              "f 1 2 4\n"
+                              "o #only a comment\n"
+                              "f 1 3 4\n");
+  const auto groups = read_mesh_file(file);
+  ASSERT_EQ(groups.size(), 3u);
+  EXPECT_EQ(groups[0].name, "cloth");
+  EXPECT_EQ(groups[1].name, "part#2 left");
+  EXPECT_EQ(groups[2].name, "comments_2");  // no name left: unnamed
+}
+
 TEST(ObjReader, OneGroupWithFacesKeepsAllVerticesAndItsName) {
   TempDir dir;
   const auto file = dir.write("one.obj",
