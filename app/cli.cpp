@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include <signal.h>
+
 namespace vproxq {
 namespace {
 
@@ -287,6 +289,12 @@ int cli_main(int argc, char** argv) {
     // run writes its files and exits with its own code. Without -o the summary on stdout is the
     // product, and SIGPIPE ends the run as it ends any filter (no files are written then).
     if (!config.output_dir.empty()) std::signal(SIGPIPE, SIG_IGN);
+    // A write past the file-size limit (`ulimit -f`) fails with EFBIG and is reported like any
+    // failed write (exit 4), for the summary on stdout as for the result files (io/output.cpp),
+    // instead of ending the run by SIGXFSZ. A signal the caller ignores or handles is left so.
+    struct sigaction xfsz {};
+    if (::sigaction(SIGXFSZ, nullptr, &xfsz) == 0 && !(xfsz.sa_flags & SA_SIGINFO) && xfsz.sa_handler == SIG_DFL)
+      std::signal(SIGXFSZ, SIG_IGN);
     // Options that the chosen backend does not use: said once, so that a sweep over --grid
     // with the default --voronoi=off does not silently measure the same run again and again.
     if (!config.quiet && config.voronoi == "off" && config.grid > 0)

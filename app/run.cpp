@@ -20,8 +20,11 @@
 #include "io/scene_source.hpp"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstdarg>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <map>
 #include <memory>
 #include <string>
@@ -45,54 +48,74 @@ std::vector<std::string> canonical_queries(const std::vector<std::string>& reque
   return out;
 }
 
-void print_ccd_summary(const CcdStepResult& c) {
-  std::printf("  ccd -> frame %d: %zu vertex-face and %zu edge-edge pairs collide\n", c.to_frame,
-              c.vf.size(), c.ee.size());
-  for (const auto& p : c.pairs)
-    std::printf("  ccd objects %4d %4d  earliest toi %.17g  primitive pairs %llu\n", p.objects[0],
-                p.objects[1], p.toi, static_cast<unsigned long long>(p.primitive_pairs));
-  for (const auto& s : c.skipped) std::printf("  ccd skipped object %d: %s\n", s.object, s.reason.c_str());
+/// Appends printf-formatted text to `out`.
+[[gnu::format(printf, 2, 3)]] void appendf(std::string& out, const char* format, ...) {
+  char small[512];
+  std::va_list args;
+  va_start(args, format);
+  std::va_list again;
+  va_copy(again, args);
+  const int n = std::vsnprintf(small, sizeof small, format, args);
+  va_end(args);
+  if (n >= 0 && static_cast<std::size_t>(n) < sizeof small) {
+    out.append(small, static_cast<std::size_t>(n));
+  } else if (n > 0) {
+    const std::size_t at = out.size();
+    out.resize(at + static_cast<std::size_t>(n) + 1);
+    std::vsnprintf(&out[at], static_cast<std::size_t>(n) + 1, format, again);
+    out.resize(at + static_cast<std::size_t>(n));
+  }
+  va_end(again);
 }
 
-void print_summary(const FrameResult& r) {
+void ccd_summary(std::string& out, const CcdStepResult& c) {
+  appendf(out, "  ccd -> frame %d: %zu vertex-face and %zu edge-edge pairs collide\n", c.to_frame, c.vf.size(),
+          c.ee.size());
+  for (const auto& p : c.pairs)
+    appendf(out, "  ccd objects %4d %4d  earliest toi %.17g  primitive pairs %llu\n", p.objects[0], p.objects[1],
+            p.toi, static_cast<unsigned long long>(p.primitive_pairs));
+  for (const auto& s : c.skipped) appendf(out, "  ccd skipped object %d: %s\n", s.object, valid_utf8(s.reason).c_str());
+}
+
+/// One frame's summary, as printed without -o: the frame, intersecting pairs, PD, CCD, then per
+/// object its nearest object and its intra-object minimum. Names as the result files write them.
+void frame_summary(std::string& out, const FrameResult& r) {
   std::size_t tris = 0;
   for (const auto& o : r.objects) tris += static_cast<std::size_t>(o.triangles);
-  std::printf("frame %d: %zu objects, %zu triangles, %.1f ms\n", r.frame, r.objects.size(), tris,
-              r.time_ms.total);
-  if (r.intersecting_pairs) std::printf("  intersecting triangle pairs: %zu\n", r.intersecting_pairs->size());
+  appendf(out, "frame %d: %zu objects, %zu triangles, %.1f ms\n", r.frame, r.objects.size(), tris, r.time_ms.total);
+  if (r.intersecting_pairs) appendf(out, "  intersecting triangle pairs: %zu\n", r.intersecting_pairs->size());
   if (r.pd)
     for (const auto& p : *r.pd) {
       if (p.status == PdStatus::Ok)
-        std::printf("  pd %d-%d: depth %.17g direction (%.6g, %.6g, %.6g)\n", p.objects[0], p.objects[1],
-                    p.depth, p.direction.x(), p.direction.y(), p.direction.z());
+        appendf(out, "  pd %d-%d: depth %.17g direction (%.6g, %.6g, %.6g)\n", p.objects[0], p.objects[1], p.depth,
+                p.direction.x(), p.direction.y(), p.direction.z());
       else
-        std::printf("  pd %d-%d: %s\n", p.objects[0], p.objects[1], pd_status_name(p.status));
+        appendf(out, "  pd %d-%d: %s\n", p.objects[0], p.objects[1], pd_status_name(p.status));
     }
-  if (r.ccd) print_ccd_summary(*r.ccd);
-  if (!r.inter) return;
-  for (const auto& d : *r.inter) {
-    const auto& name = r.objects[static_cast<std::size_t>(d.object)].name;
-    if (!d.has_nearest()) {
-      std::printf("  %4d %-16s no other object\n", d.object, name.c_str());
-      continue;
+  if (r.ccd) ccd_summary(out, *r.ccd);
+  std::vector<std::string> names;
+  names.reserve(r.objects.size());
+  for (const auto& o : r.objects) names.push_back(valid_utf8(o.name));
+  if (r.inter)
+    for (const auto& d : *r.inter) {
+      const auto& name = names[static_cast<std::size_t>(d.object)];
+      if (!d.has_nearest()) {
+        appendf(out, "  %4d %-16s no other object\n", d.object, name.c_str());
+        continue;
+      }
+      appendf(out, "  %4d %-16s nearest %4d %-16s distance %.17g  triangles %d,%d\n", d.object, name.c_str(),
+              d.nearest_object, names[static_cast<std::size_t>(d.nearest_object)].c_str(), d.distance,
+              d.triangles[0], d.triangles[1]);
     }
-    std::printf("  %4d %-16s nearest %4d %-16s distance %.17g  triangles %d,%d\n", d.object,
-                name.c_str(), d.nearest_object,
-                r.objects[static_cast<std::size_t>(d.nearest_object)].name.c_str(), d.distance,
+  if (r.intra)
+    for (const auto& d : *r.intra) {
+      const auto& name = names[static_cast<std::size_t>(d.object)];
+      if (!d.has_pair())
+        appendf(out, "  %4d %-16s self: no non-adjacent triangles\n", d.object, name.c_str());
+      else
+        appendf(out, "  %4d %-16s self distance %.17g  triangles %d,%d\n", d.object, name.c_str(), d.distance,
                 d.triangles[0], d.triangles[1]);
-  }
-}
-
-void print_intra_summary(const FrameResult& r) {
-  if (!r.intra) return;
-  for (const auto& d : *r.intra) {
-    const auto& name = r.objects[static_cast<std::size_t>(d.object)].name;
-    if (!d.has_pair())
-      std::printf("  %4d %-16s self: no non-adjacent triangles\n", d.object, name.c_str());
-    else
-      std::printf("  %4d %-16s self distance %.17g  triangles %d,%d\n", d.object, name.c_str(),
-                  d.distance, d.triangles[0], d.triangles[1]);
-  }
+    }
 }
 
 /// The Stage II backend of a run, and the GL context it may need (destroyed after it).
@@ -274,6 +297,7 @@ void run(const Config& config) {
   std::optional<Frame> next_frame;
   StaticIntraCache static_intra;
   Progress progress(info.frame_count, !config.quiet);
+  std::string summary;  ///< without -o: what is printed when the run ends
   for (long k = first; k < last; ++k) {
     Stopwatch total;
     FrameResult result;
@@ -356,14 +380,21 @@ void run(const Config& config) {
       // write_frame() fills in and adds its own time before serialising the stats.
       writer->write_frame(std::move(result));
     } else if (!config.quiet) {
-      progress.clear();
-      std::fflush(stdout);
-      print_summary(result);
-      print_intra_summary(result);
+      frame_summary(summary, result);
     }
     progress.update(static_cast<std::size_t>(k - first + 1));
   }
   progress.finish();
+  if (!summary.empty()) {
+    // Printed whole at the end, so that a run that fails part-way (a bad frame) prints none of
+    // it, as it writes no files. A failed write is a runtime error (a full disk, a file-size
+    // limit: SIGXFSZ is ignored, see app/cli.cpp); a closed pipe ends the run by SIGPIPE.
+    errno = 0;
+    const bool written = std::fwrite(summary.data(), 1, summary.size(), stdout) == summary.size();
+    if (!written || std::fflush(stdout) != 0)
+      throw RuntimeError(std::string("cannot write the summary to standard output: ") +
+                         (errno != 0 ? std::strerror(errno) : "write error"));
+  }
   if (writer) {
     writer->commit();
     if (!config.quiet)

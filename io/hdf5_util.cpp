@@ -1,7 +1,5 @@
 #include "io/hdf5_util.hpp"
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 
 namespace vproxq::h5 {
@@ -47,12 +45,6 @@ Handle vlen_string_type() {
     return Handle();
   }
   return type;
-}
-
-std::string valid_utf8(const std::string& text) {
-  const std::string quoted =
-      nlohmann::json(text).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-  return nlohmann::json::parse(quoted).get<std::string>();
 }
 
 }  // namespace vproxq::h5

@@ -71,9 +71,4 @@ std::string failure_text(const char* call, const std::string& file, const std::s
 /// A variable-length UTF-8 string type (caller owns the handle).
 Handle vlen_string_type();
 
-/// `text` as valid UTF-8, for the UTF-8 strings of the HDF5 file: invalid byte sequences
-/// replaced by U+FFFD exactly as results.json writes them (nlohmann's
-/// error_handler_t::replace), so that the two files hold the same names.
-std::string valid_utf8(const std::string& text);
-
 }  // namespace vproxq::h5

@@ -2,6 +2,7 @@
 
 #include "core/errors.hpp"
 #include "io/hdf5_util.hpp"
+#include "io/output.hpp"
 
 #include <algorithm>
 #include <cstddef>
@@ -351,7 +352,7 @@ struct Hdf5ResultWriter::Impl {
   }
   void write_attribute(hid_t owner, const std::string& owner_name, const char* name,
                        const std::string& value) const {
-    const std::string valid = h5::valid_utf8(value);
+    const std::string valid = valid_utf8(value);
     const char* text = valid.c_str();
     write_attribute(owner, owner_name, name, string_type.get(), string_type.get(), &text);
   }
@@ -372,7 +373,7 @@ struct Hdf5ResultWriter::Impl {
                        const std::vector<std::string>& values) const {
     const std::string where = owner_name + "@" + name;
     std::vector<std::string> valid;
-    for (const std::string& v : values) valid.push_back(h5::valid_utf8(v));
+    for (const std::string& v : values) valid.push_back(valid_utf8(v));
     std::vector<const char*> texts;
     texts.reserve(values.size());
     for (const std::string& v : valid) texts.push_back(v.c_str());
@@ -435,7 +436,7 @@ struct Hdf5ResultWriter::Impl {
       row.triangles = o.triangles;
       row.is_static = o.is_static ? 1 : 0;
       rows.push_back(row);
-      valid.push_back(h5::valid_utf8(o.name));
+      valid.push_back(valid_utf8(o.name));
       names.push_back(valid.back().c_str());
     }
     write_dataset(group, where, "objects", object_file_type.get(), object_mem_type.get(),
@@ -558,7 +559,7 @@ struct Hdf5ResultWriter::Impl {
     valid.reserve(c.skipped.size());
     for (const CcdSkipped& s : c.skipped) {
       skipped.push_back(s.object);
-      valid.push_back(h5::valid_utf8(s.reason));
+      valid.push_back(valid_utf8(s.reason));
       reasons.push_back(valid.back().c_str());
     }
     write_dataset(g, ccd_where, "skipped_objects", H5T_STD_I32LE, H5T_NATIVE_INT32, skipped.size(),

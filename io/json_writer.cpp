@@ -1,12 +1,23 @@
 #include "io/json_writer.hpp"
 
 #include "core/errors.hpp"
+#include "io/output.hpp"
 
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
 
 #include <unistd.h>
+
+namespace vproxq {
+
+std::string valid_utf8(const std::string& text) {
+  const std::string quoted =
+      nlohmann::json(text).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  return nlohmann::json::parse(quoted).get<std::string>();
+}
+
+}  // namespace vproxq
 
 namespace vproxq::detail {
 

@@ -5,8 +5,14 @@
 
 #include <filesystem>
 #include <memory>
+#include <string>
 
 namespace vproxq {
+
+/// `text` as valid UTF-8: invalid byte sequences replaced by U+FFFD, as results.json, results.h5
+/// and the summary on stdout write names and paths (nlohmann's error_handler_t::replace), so
+/// that all three hold the same strings.
+std::string valid_utf8(const std::string& text);
 
 class ResultWriter {
  public:

@@ -353,6 +353,45 @@ TEST(Cli, AWritePastTheFileSizeLimitIsAnErrorThatLeavesNothingBehind) {
   EXPECT_FALSE(fs::exists(dir / "a")) << r.output;
 }
 
+// Without -o the summary on stdout is printed whole when the run ends: a run that fails part-way
+// (frame 1's object count differs from frame 0's) prints none of frame 0's, as it writes no
+// files; and a summary write past the file-size limit is a runtime error (exit 4, naming
+// standard output), not the end by SIGXFSZ.
+TEST(Cli, TheSummaryIsPrintedWholeOrNotAtAll) {
+  ScratchDir dir;
+  const std::string two = "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no b\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf 4 5 6\n";
+  dir.write("f_0.obj", two);
+  dir.write("f_1.obj", "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const auto scene = dir.write("scene.json", R"({"frames": {"pattern": "f_%d.obj", "count": 2}})");
+  const std::string binary = std::string(VPROXQ_BINARY) + " " + quote(scene);
+  auto r = test::run_command("{ " + binary + " > " + quote(dir / "stdout.txt") + "; }");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("frame 1 has 1 objects"), std::string::npos) << r.output;
+  EXPECT_EQ(slurp(dir / "stdout.txt"), "");
+  // Frame 0 alone succeeds and prints its summary.
+  r = test::run_command("{ " + binary + " --frames 0 > " + quote(dir / "stdout.txt") + "; }");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(slurp(dir / "stdout.txt").rfind("frame 0: 2 objects, 2 triangles", 0), 0u) << slurp(dir / "stdout.txt");
+  // 1 block (512 or 1024 bytes, by the shell) below the summary of skirt-tiny's frames.
+  r = test::run_command("{ ulimit -c 0; ulimit -f 1; " + std::string(VPROXQ_BINARY) + " " +
+                        quote(kSamples / "skirt-tiny" / "scene.json") + " > " + quote(dir / "big.txt") + "; }");
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  EXPECT_NE(r.output.find("cannot write the summary to standard output: File too large"), std::string::npos)
+      << r.output;
+}
+
+// Object names that are not valid UTF-8 are printed in the summary as the result files write
+// them, with U+FFFD for each bad sequence.
+TEST(Cli, TheSummaryPrintsNamesAsTheResultFilesWriteThem) {
+  ScratchDir dir;
+  const auto mesh = dir.write("names.obj", "o caf\xe9\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
+                                           "o b\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf 4 5 6\n");
+  const auto r = vproxq(quote(mesh));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("caf\xef\xbf\xbd "), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("caf\xe9"), std::string::npos) << r.output;
+}
+
 // A run killed without a chance to clean up (SIGKILL, the out-of-memory killer) leaves its
 // temporaries; the next run into the same directory removes those of processes of this host
 // that no longer exist, and nothing else.
