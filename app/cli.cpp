@@ -158,6 +158,11 @@ int parse_or_exit(CLI::App& app, int argc, char** argv, bool& done) {
     }
     // The short form takes its value after a space or directly (-o OUT, -oOUT): `-o=OUT` would
     // write into a directory named "=OUT".
+    if (arg == "-o=") {
+      done = true;
+      std::fprintf(stderr, "vproxq: usage error: -o= has no value: write -o OUT, -oOUT or --output=OUT\nRun with --help for the options.\n");
+      return exit_code::kUsage;
+    }
     if (arg.compare(0, 3, "-o=") == 0) {
       done = true;
       std::fprintf(stderr, "vproxq: usage error: %s: write -o %s or --output=%s (a directory whose name starts with '=': -o ./%s)\nRun with --help for the options.\n",
@@ -196,6 +201,7 @@ int diff_main(int argc, char** argv) {
       ->check(tolerance());
   app.add_option("--atol", opts.atol, "absolute tolerance for numbers (default 0)")
       ->check(tolerance());
+  app.set_version_flag("--version", std::string("vproxq ") + VPROXQ_VERSION);
   bool done = false;
   const int code = parse_or_exit(app, argc, argv, done);
   if (done) return code;
@@ -220,6 +226,7 @@ int check_ccd_main(int argc, char** argv) {
   app.add_option("--type", type, "vf (vertex-face) or ee (edge-edge)")
       ->required()
       ->check(CLI::IsMember({"vf", "ee"}));
+  app.set_version_flag("--version", std::string("vproxq ") + VPROXQ_VERSION);
   bool done = false;
   const int code = parse_or_exit(app, argc, argv, done);
   if (done) return code;

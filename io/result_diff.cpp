@@ -2,6 +2,8 @@
 
 #include "core/errors.hpp"
 #include "io/json_check.hpp"
+#include "io/output.hpp"
+#include "io/read_util.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -47,15 +49,22 @@ Json load_results(const fs::path& file) {
   // <(jq . a.json) b.json`) cannot be read twice.
   std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   if (in.bad()) throw InputError("cannot read results file '" + file.string() + "': " + std::strerror(errno));
+  // The other file of a run (its 8-byte signature): said so, instead of a JSON parse error that
+  // quoted a binary byte.
+  if (text.compare(0, 8, "\x89HDF\r\n\x1a\n", 8) == 0)
+    throw InputError("'" + file.string() + "' is an HDF5 file (results.h5); vproxq diff compares results.json files");
+  // A parser's message may quote the bytes it stopped at: shown as valid UTF-8, control bytes
+  // as \xNN, so that a binary file cannot put raw bytes on the terminal.
+  auto shown = [](const std::string& message) { return io_detail::abbreviate(valid_utf8(message), 400); };
   {
     std::istringstream check(text);
     const std::string problem = json_structure_problem(check, kMaxDepth, /*unique_keys=*/true, /*integers_fit=*/true);
-    if (!problem.empty()) throw InputError("malformed results file '" + file.string() + "': " + problem);
+    if (!problem.empty()) throw InputError("malformed results file '" + file.string() + "': " + shown(problem));
   }
   try {
     doc = Json::parse(text);
   } catch (const nlohmann::json::exception& e) {
-    throw InputError("malformed results file '" + file.string() + "': " + e.what());
+    throw InputError("malformed results file '" + file.string() + "': " + shown(e.what()));
   }
   if (!doc.is_object() || !doc.contains("frames") || !doc["frames"].is_array()) {
     throw InputError("'" + file.string() +

@@ -285,6 +285,20 @@ int main(int argc, char** argv) {
                             {"cells", &breaking.cells, 1, 64, "grid cells along a piece's side"}});
   sims[4].generate = [&](SceneWriter& w) { generate_breaking(breaking, w); };
 
+  // An unknown first word: named, with the subcommands (CLI11 says only that one is required).
+  if (argc >= 2 && argv[1][0] != '-') {
+    std::string names;
+    bool known = false;
+    for (const CLI::App* c : app.get_subcommands([](CLI::App*) { return true; })) {
+      known = known || c->get_name() == argv[1];
+      names += (names.empty() ? "" : ", ") + c->get_name();
+    }
+    if (!known) {
+      std::cerr << "vproxq-gen: error: unknown scene '" << argv[1] << "'; expected one of: " << names
+                << "\nRun 'vproxq-gen --help' for usage.\n";
+      return exit_code::kUsage;
+    }
+  }
   try {
     app.parse(argc, argv);
     for (const SimCommand& cmd : sims)

@@ -74,6 +74,12 @@ TEST(Cli, HelpAndVersion) {
   EXPECT_NE(r.output.find(VPROXQ_VERSION), std::string::npos);
   r = vproxq("diff --help");
   EXPECT_EQ(r.exit_code, 0);
+  // The subcommands answer --version too (it was "A is required").
+  for (const char* sub : {"diff", "check-ccd"}) {
+    r = vproxq(std::string(sub) + " --version");
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(r.output, std::string("vproxq ") + VPROXQ_VERSION + "\n");
+  }
 }
 
 TEST(Cli, OptionsTheBackendDoesNotUseAreNoted) {
@@ -110,7 +116,7 @@ TEST(Cli, UsageErrors) {
            {scene + " --frames= -q", "--frames has no value"},
            // -o=OUT would write into a directory named "=OUT".
            {scene + " -o=out -q", "-o=out: write -o out or --output=out"},
-           {scene + " -o= -q", "-o=: write -o "}}) {
+           {scene + " -o= -q", "-o= has no value: write -o OUT, -oOUT or --output=OUT"}}) {
     SCOPED_TRACE(args);
     r = vproxq(args);
     EXPECT_EQ(r.exit_code, 2) << r.output;
@@ -674,6 +680,18 @@ TEST(Cli, RepeatedRunsAreIdenticalAndDiffDetectsChanges) {
   r = vproxq("diff " + quote(a) + " " + quote(dir.path()));  // the output folder, not its file
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("is a directory, not a results file"), std::string::npos) << r.output;
+  // The run's other file: named as such, and no raw binary byte on the terminal.
+  r = vproxq("diff " + quote(dir / "a" / "results.h5") + " " + quote(a));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("results.h5' is an HDF5 file (results.h5); vproxq diff compares results.json files"),
+            std::string::npos) << r.output;
+  // Another binary file (a PNG's signature): the parser's message quotes its first byte, shown
+  // as U+FFFD, not as the raw byte.
+  std::ofstream(dir / "image.png", std::ios::binary) << "\x89PNG\r\n\x1a\n";
+  r = vproxq("diff " + quote(dir / "image.png") + " " + quote(a));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("malformed results file"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find('\x89'), std::string::npos) << r.output;
 }
 
 TEST(Cli, FrameRangeAndSummary) {

@@ -123,6 +123,18 @@ TEST(SimScenes, FullSizeDefaultsMatchThePapersTriangleCounts) {
   }
 }
 
+// An unknown scene name is a usage error that names it and lists the scenes (CLI11 alone said
+// "A subcommand is required"), with nothing written.
+TEST(SimScenes, AnUnknownSceneIsNamed) {
+  ScratchDir dir;
+  const auto r = generate("blob --objects 2", dir / "out");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("unknown scene 'blob'; expected one of: blobs, skirt, cloth-ball, bowl, funnel, breaking"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
 TEST(SimScenes, BreakingObjectsComeApartIntoAtLeast25Pieces) {
   // Full size, two frames: the start (14 whole objects) and the end of the simulation.
   ScratchDir dir;
