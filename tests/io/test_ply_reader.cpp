@@ -323,31 +323,31 @@ TEST(PlyReaderErrors, AsciiDataProblems) {
 // read on into the next record.
 TEST(PlyReaderErrors, AsciiRecordsAreLines) {
   TempDir dir;
-  // Vertex rows that carry normals the header does not declare: the error names the row.
-  const auto normals = dir.write(
-      "normals.ply", ascii_header(kXyz, kFaces + "end_header\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n"));
-  EXPECT_INPUT_ERROR(read_mesh_file(normals), normals.string() + ": line 10: more values than the header declares",
-                     "element 'vertex' record 0 (0-based) of 3: '0' after its last property");
-  // A long row and a short one that make up for each other: read as a stream, vertex 2 came out
-  // as (0.5, 0, 1) without a word.
-  const auto silent = dir.write(
-      "silent.ply", ascii_header(kXyz, kFaces + "end_header\n0 0 0\n1 0 0 0.5\n0 1\n3 0 1 2\n"));
-  EXPECT_INPUT_ERROR(read_mesh_file(silent), silent.string() + ": line 11: more values than the header declares",
-                     "element 'vertex' record 1 (0-based) of 3: '0.5'");
-  // A short row alone.
-  const auto short_row = dir.write(
-      "short.ply", ascii_header(kXyz, kFaces + "end_header\n0 0 0\n1 0\n0 1 0\n3 0 1 2\n"));
-  EXPECT_INPUT_ERROR(read_mesh_file(short_row), short_row.string() + ": line 11: fewer values than the header declares",
-                     "element 'vertex' record 1 (0-based) of 3");
-  // A face whose list is longer or shorter than its count says.
-  const auto long_face = dir.write(
-      "long_face.ply", ascii_header(kXyz, kFaces + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 0\n"));
-  EXPECT_INPUT_ERROR(read_mesh_file(long_face), long_face.string() + ": line 13: more values than the header declares",
-                     "element 'face' record 0 (0-based) of 1");
-  const auto split_face = dir.write(
-      "split_face.ply", ascii_header(kXyz, kFaces + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n2\n"));
-  EXPECT_INPUT_ERROR(read_mesh_file(split_face), split_face.string() + ": line 13: fewer values than the header declares",
-                     "element 'face' record 0 (0-based) of 1");
+  struct Case {
+    const char* name;
+    const char* body;  ///< after the header (its last line is line 9)
+    const char* says;
+    const char* record;
+  };
+  for (const Case& c : {
+           // Vertex rows that carry normals the header does not declare: the error names the row.
+           Case{"normals", "0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n", "line 10: more values than",
+                "element 'vertex' record 0 (0-based) of 3: '0' after its last property"},
+           // A long row and a short one that make up for each other: read as a stream, vertex 2
+           // came out as (0.5, 0, 1) without a word.
+           Case{"silent", "0 0 0\n1 0 0 0.5\n0 1\n3 0 1 2\n", "line 11: more values than",
+                "element 'vertex' record 1 (0-based) of 3: '0.5'"},
+           Case{"short", "0 0 0\n1 0\n0 1 0\n3 0 1 2\n", "line 11: fewer values than",
+                "element 'vertex' record 1 (0-based) of 3"},
+           // A face whose list is longer or shorter than its count says.
+           Case{"long_face", "0 0 0\n1 0 0\n0 1 0\n3 0 1 2 0\n", "line 13: more values than",
+                "element 'face' record 0 (0-based) of 1"},
+           Case{"split_face", "0 0 0\n1 0 0\n0 1 0\n3 0 1\n2\n", "line 13: fewer values than",
+                "element 'face' record 0 (0-based) of 1"}}) {
+    SCOPED_TRACE(c.name);
+    const auto file = dir.write(std::string(c.name) + ".ply", ascii_header(kXyz, kFaces + "end_header\n" + c.body));
+    EXPECT_INPUT_ERROR(read_mesh_file(file), file.string() + ": " + c.says + " the header declares", c.record);
+  }
   // Spaces, tabs and CR before the line end are whitespace, not values.
   const auto crlf = dir.write(
       "crlf.ply", ascii_header(kXyz, kFaces + "end_header\r\n0 0 0 \t\r\n1 0 0\r\n\r\n0 1 0\r\n3 0 1 2\r\n"));
