@@ -311,10 +311,7 @@ class AsciiCursor {
   /// Throws unless only whitespace is left: values past the header's counts mean the counts
   /// do not describe the file.
   void expect_end() {
-    while (p_ < end_ && is_space_or_newline(*p_)) {
-      if (*p_ == '\n') ++line_;
-      ++p_;
-    }
+    skip_blank(true);
     if (p_ != end_) {
       const char* b = p_;
       while (p_ < end_ && !is_space_or_newline(*p_)) ++p_;
