@@ -122,6 +122,12 @@ TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b) {
     r.feature_b = static_cast<std::int8_t>(eb);
   }
   r.distance = std::sqrt(best);
+  // Triangles that do not touch can still compute as 0 apart: a gap below about one ulp of
+  // their coordinates (a vertex within rounding of the other's plane, say) rounds away in the
+  // coordinate differences. 0 stays the answer of touching pairs alone (decided exactly
+  // above), so such a pair gets the smallest positive double instead: as accurate as 0, and a
+  // touching pair beats it in every search and tie-break.
+  if (r.distance == 0.0) r.distance = std::numeric_limits<double>::denorm_min();
   return r;
 }
 

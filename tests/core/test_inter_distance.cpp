@@ -107,6 +107,33 @@ TEST(InterDistance, TiesGoToTheSmallestIds) {
   EXPECT_EQ(got.per_object[2].distance, 0.0);
 }
 
+TEST(InterDistance, AContactBeatsAGapBelowRounding) {
+  // Found by an independent exact oracle: A and B both cross C, and B's apex is 8.9e-18 from A
+  // (an exact rational computation), a gap the coordinate differences round away. That
+  // computed 0 used to win the tie-break by the smaller id, so A and B were each other's
+  // nearest object at "distance 0" while the intersecting pairs listed (A, C) and (B, C).
+  // Distance 0 now means a contact only.
+  const Object a = test::make_object({Vec3(0.0, 0.0, 0.6), Vec3(1.0, 0.0, -0.57), Vec3(0.0, 1.0, -0.53)},
+                                     {{0, 1, 2}}, "A");
+  const Object b = test::make_object({Vec3(0.12, 0.25, 0.1771), Vec3(0.01999999999999999, 0.15, 0.6771),
+                                      Vec3(0.32, 0.2, 0.6771), Vec3(0.12, 0.45, 0.6771)},
+                                     {{0, 1, 2}, {0, 2, 3}, {0, 3, 1}, {1, 3, 2}}, "B");
+  const Object c = test::make_object({Vec3(0.0, 0.0, 0.3), Vec3(1.0, 0.0, 0.91), Vec3(0.0, 1.0, 0.99)},
+                                     {{0, 1, 2}}, "C");
+  Frame frame;
+  frame.objects = {a, b, c};
+  const auto got = inter_object_distance(frame, {1});
+  test::expect_same_inter(got, inter_object_distance_brute_force(frame), "contact and rounded gap");
+  EXPECT_EQ(got.per_object[0].nearest_object, 2);
+  EXPECT_EQ(got.per_object[0].distance, 0.0);
+  EXPECT_EQ(got.per_object[0].kind, TriangleDistanceCase::Intersecting);
+  EXPECT_EQ(got.per_object[1].nearest_object, 2);  // B crosses C too (and was given A)
+  EXPECT_EQ(got.per_object[1].distance, 0.0);
+  const double gap = object_distance(frame, 0, 1);
+  EXPECT_GT(gap, 0.0);
+  EXPECT_LT(gap, 1e-15);
+}
+
 TEST(InterDistance, SingleObjectAndEmptyObjectsHaveNoNearest) {
   Rng rng(5);
   Frame one;

@@ -35,6 +35,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -171,6 +172,13 @@ int first_minimum_candidate(const Triangle& a, const Triangle& b) {
   return best_index;
 }
 
+/// The distance triangle_distance() reports for a winning candidate's squared distance: its
+/// square root, but the smallest positive double for 0 (0 is for touching triangles alone).
+double reported_distance(double squared) {
+  const double d = std::sqrt(squared);
+  return d == 0.0 ? std::numeric_limits<double>::denorm_min() : d;
+}
+
 /// All checks of one triangle pair against the twin; returns the result.
 TriangleDistanceResult check_pair(const Triangle& a, const Triangle& b, ErrorStats* stats = nullptr) {
   const double unit = kEpsilon * scale_of(a, b);
@@ -199,6 +207,7 @@ TriangleDistanceResult check_pair(const Triangle& a, const Triangle& b, ErrorSta
     EXPECT_LE(pa_err, tol);
     EXPECT_LE(pb_err, tol);
     EXPECT_NEAR((r.point_a - r.point_b).norm(), r.distance, tol);
+    EXPECT_GT(r.distance, 0.0);
     // The reported feature pair is the first minimum in the documented order, and its
     // distance and points are bitwise those of the stand-alone primitive.
     const int first = first_minimum_candidate(a, b);
@@ -207,7 +216,7 @@ TriangleDistanceResult check_pair(const Triangle& a, const Triangle& b, ErrorSta
       EXPECT_EQ(r.feature_a, first);
       EXPECT_EQ(r.feature_b, -1);
       const PointTriangleResult p = point_triangle_distance(a[first], b);
-      EXPECT_EQ(r.distance, std::sqrt(p.squared_distance));
+      EXPECT_EQ(r.distance, reported_distance(p.squared_distance));
       EXPECT_EQ(r.point_a, a[first]);
       EXPECT_EQ(r.point_b, p.closest);
     } else if (first < 6) {
@@ -215,7 +224,7 @@ TriangleDistanceResult check_pair(const Triangle& a, const Triangle& b, ErrorSta
       EXPECT_EQ(r.feature_a, -1);
       EXPECT_EQ(r.feature_b, first - 3);
       const PointTriangleResult p = point_triangle_distance(b[first - 3], a);
-      EXPECT_EQ(r.distance, std::sqrt(p.squared_distance));
+      EXPECT_EQ(r.distance, reported_distance(p.squared_distance));
       EXPECT_EQ(r.point_a, p.closest);
       EXPECT_EQ(r.point_b, b[first - 3]);
     } else {
@@ -225,7 +234,7 @@ TriangleDistanceResult check_pair(const Triangle& a, const Triangle& b, ErrorSta
       EXPECT_EQ(r.feature_a, ea);
       EXPECT_EQ(r.feature_b, eb);
       const SegmentSegmentResult e = segment_segment_distance(a[ea], a[(ea + 1) % 3], b[eb], b[(eb + 1) % 3]);
-      EXPECT_EQ(r.distance, std::sqrt(e.squared_distance));
+      EXPECT_EQ(r.distance, reported_distance(e.squared_distance));
       EXPECT_EQ(r.point_a, e.point_a);
       EXPECT_EQ(r.point_b, e.point_b);
     }
@@ -876,6 +885,43 @@ TEST(TriangleDistance, KnownFeaturesAndTieOrder) {
   EXPECT_EQ(r.kind, TriangleDistanceCase::Intersecting);
   EXPECT_EQ(r.point_a, Vec3(1, 1, 0));
   EXPECT_EQ(r.point_b, r.point_a);
+}
+
+TEST(TriangleDistance, ZeroOnlyForTouchingPairs) {
+  // Found by an independent exact oracle: the apex of b lies 1.23e-17 below a (an exact
+  // rational computation), which the coordinate differences round away, so the distance
+  // computed as 0 although the exact predicates say the triangles are apart.
+  const Triangle a = {Vec3(0.0, 0.0, -0.99), Vec3(1.0, 0.0, -0.05), Vec3(0.0, 1.0, -0.57)};
+  const Triangle b = {Vec3(0.09, 0.37, -0.75), Vec3(-0.010000000000000009, 0.27, -1.25),
+                      Vec3(0.29000000000000004, 0.32, -1.25)};
+  ASSERT_FALSE(triangles_intersect(a, b));
+  TriangleDistanceResult r = triangle_distance(a, b);
+  EXPECT_EQ(r.distance, std::numeric_limits<double>::denorm_min());
+  EXPECT_NE(r.kind, TriangleDistanceCase::Intersecting);
+  // Corners of b placed on a's plane by rounded barycentric combinations: some land exactly
+  // on it (touching), most within rounding of it on either side. Distance 0 exactly when the
+  // exact predicates find a common point.
+  std::mt19937_64 rng(35);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int touching = 0, rounded_apart = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const Triangle c = random_triangle(rng, Vec3::Zero(), 1.0);
+    const double u = 0.5 * unit(rng), v = 0.5 * unit(rng);
+    const Vec3 p = c[0] + u * (c[1] - c[0]) + v * (c[2] - c[0]);
+    const Vec3 n = (c[1] - c[0]).cross(c[2] - c[0]).normalized();
+    const double side = trial % 2 == 0 ? 1.0 : -1.0;
+    const Triangle d = {p, p + side * n + random_vec(rng, 0.3), p + side * n + random_vec(rng, 0.3)};
+    const bool hit = triangles_intersect(c, d);
+    r = triangle_distance(c, d);
+    ASSERT_EQ(r.distance == 0.0, hit) << "trial " << trial << ": distance " << r.distance;
+    ASSERT_EQ(r.kind == TriangleDistanceCase::Intersecting, hit) << "trial " << trial;
+    touching += hit;
+    rounded_apart += !hit && r.distance == std::numeric_limits<double>::denorm_min();
+  }
+  std::printf("[ info ] 20000 corners on a plane: %d touching, %d apart by less than rounding\n",
+              touching, rounded_apart);
+  EXPECT_GT(touching, 0);
+  EXPECT_GT(rounded_apart, 0);
 }
 
 TEST(TriangleDistance, DeterministicBitwise) {

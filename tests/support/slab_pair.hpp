@@ -306,9 +306,10 @@ inline std::optional<long double> slab_feature_distance(const SlabPair& s, unsig
 
 /// Every check of one pair; returns the first failure as a message ("" when all hold).
 ///   - triangle_distance, both argument orders: exactly 0 and Intersecting when m = 0 and the
-///     top features meet, never Intersecting otherwise (triangles_intersect agrees); the exact
-///     distance where slab_feature_distance knows it, at least m |n| otherwise (within the
-///     tolerance); points as far apart as the distance says, on their sides of the slab.
+///     top features meet, never Intersecting and never 0 otherwise (triangles_intersect
+///     agrees); the exact distance where slab_feature_distance knows it, at least m |n|
+///     otherwise (within the tolerance); points as far apart as the distance says, on their
+///     sides of the slab.
 ///   - each of the 6 vertex-triangle and 9 edge-edge primitives: the same, feature by feature.
 /// With `worst`, also raises *worst to the largest error against a known distance, in e*S.
 inline std::string check_slab_pair(const SlabPair& s, double* worst = nullptr) {
@@ -348,6 +349,10 @@ inline std::string check_slab_pair(const SlabPair& s, double* worst = nullptr) {
         return fail.str();
       }
       continue;
+    }
+    if (!(r.distance > 0)) {  // 0 is for touching triangles alone
+      fail << name << ": apart but distance " << r.distance;
+      return fail.str();
     }
     if (!check_value(name, r.distance, whole)) return fail.str();
     // The points: as far apart as the distance, and on their sides of the slab.
