@@ -27,19 +27,20 @@ struct TriangleDistanceResult {
 /// Distance between the closed triangles a and b (any shape, degenerate ones included).
 /// Intersection is decided with exact orientation predicates, so touching or crossing
 /// triangles give exactly 0, and only they do: triangles apart by less than rounding, whose
-/// computed distance is 0, get the smallest positive double (denorm_min) instead. Otherwise the distance is the minimum over the 6 vertex–face and
-/// 9 edge–edge feature pairs, ties going to the first in that order.
+/// computed distance is 0, get the smallest positive double (denorm_min) instead. Otherwise
+/// the distance is the minimum over the 6 vertex–face and 9 edge–edge feature pairs, ties
+/// going to the first in that order.
 ///
 /// Details (core/geometry/triangle_distance.cpp): the order is VF a0, a1, a2, FV b0, b1, b2,
 /// then EE (feature_a, feature_b) row-major; squared distances are compared and the square root
 /// taken once; each candidate's value is bitwise that of point_triangle_distance() or
 /// segment_segment_distance() (the winner's square root: that distance, but denorm_min for 0),
-/// and the reported points are theirs. Distances are accurate to a
-/// few ulps of the largest coordinate (they are computed from coordinate differences); points
-/// are rounded to their coordinates' grid. For intersecting triangles point_a == point_b is one
-/// common point, computed approximately (within a few ulps of both triangles). Deterministic:
-/// equal inputs give bitwise equal results. Inputs must be finite; exactness of the intersection
-/// decision holds for coordinates of magnitude in [2^-200, 2^200] or zero (predicates.hpp).
+/// and the reported points are theirs. Distances are accurate to a few ulps of the largest
+/// coordinate (they are computed from coordinate differences); points are rounded to their
+/// coordinates' grid. For intersecting triangles point_a == point_b is one common point,
+/// computed approximately (within a few ulps of both triangles). Deterministic: equal inputs
+/// give bitwise equal results. Inputs must be finite; exactness of the intersection decision
+/// holds for coordinates of magnitude in [2^-200, 2^200] or zero (predicates.hpp).
 TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b);
 
 /// r seen from the other triangle's side: points, features and the vertex–face case swapped.

@@ -310,7 +310,8 @@ inline std::optional<long double> slab_feature_distance(const SlabPair& s, unsig
 ///     agrees); the exact distance where slab_feature_distance knows it, at least m |n|
 ///     otherwise (within the tolerance); points as far apart as the distance says, on their
 ///     sides of the slab.
-///   - each of the 6 vertex-triangle and 9 edge-edge primitives: the same, feature by feature.
+///   - each of the 6 vertex-triangle and 9 edge-edge primitives: the same values, feature by
+///     feature (a primitive may give 0 for features apart by less than rounding).
 /// With `worst`, also raises *worst to the largest error against a known distance, in e*S.
 inline std::string check_slab_pair(const SlabPair& s, double* worst = nullptr) {
   const double tol = kSlabTolUlps * 0x1p-53 * s.scale;
