@@ -1,6 +1,7 @@
 #include "core/query/penetration_depth.hpp"
 
 #include "core/broad_phase/triangle_bvh.hpp"
+#include "core/geometry/exact_distance.hpp"
 #include "core/geometry/point_triangle.hpp"
 #include "core/geometry/predicates.hpp"
 #include "core/geometry/triangle_intersection.hpp"
@@ -125,6 +126,7 @@ int winding_number(const Vec3& p, const Object& o, const TriangleBvh& bvh, bool&
 struct ObjectView {
   const Object* object;
   const TriangleBvh* bvh;
+  double scale;  ///< the largest coordinate magnitude of the object
 };
 
 /// The symbolic point q above, from v inside the star face (v, n1, n2).
@@ -460,39 +462,90 @@ Walk walk_inside(const ObjectView& a, const ObjectView& b, const std::vector<Ind
   });
 }
 
-/// Nearest point of `o`'s surface to p (ties: the smallest triangle id), leaving out the
-/// triangles t with skip(t); distance +inf when every triangle is left out. With
-/// `stop_at` >= 0 the search stops as soon as it finds a point within stop_at: the distance
-/// returned is then that point's, an upper bound at most stop_at (for a caller that only needs
-/// to know whether the distance exceeds stop_at).
+/// p's nearest point on an object's surface: its computed distance, the point, and the
+/// triangle it lies on (kNoIndex: none).
+struct Nearest {
+  double distance = kInfinity;
+  Vec3 point = Vec3::Zero();
+  Index triangle = kNoIndex;
+};
+
+/// The order of two points' exact squared distances to two triangles (a nearest triangle of
+/// each): sign(d(p, s) - d(q, u)). Computed distances farther apart than `slack` decide it
+/// (slack is far above the rounding of point_triangle_distance: see pd_slack); nearer ones, in
+/// particular exact ties, are decided in exact arithmetic.
+int compare_distances(double dp, const Vec3& p, const Triangle& s, double dq, const Vec3& q, const Triangle& u,
+                      double slack) {
+  if (dp < dq - slack) return -1;
+  if (dp > dq + slack) return 1;
+  return compare(exact_point_triangle_squared_distance(p, s), exact_point_triangle_squared_distance(q, u));
+}
+
+/// The slack of compare_distances for points and triangles of objects whose coordinates are
+/// at most `scale` in magnitude: 2^-40 scale, thousands of times the 16 e*scale that bounds
+/// the error of a computed point-triangle distance (README, "Exactness"), so that two computed
+/// distances more than the slack apart are ordered as the exact ones are.
+double pd_slack(double scale) { return 0x1p-40 * scale; }
+
+/// The largest coordinate magnitude of an object.
+double coordinate_scale(const Object& o) {
+  double s = 0;
+  for (const Vec3& v : o.positions) s = std::max(s, v.cwiseAbs().maxCoeff());
+  return s;
+}
+
+/// p's nearest point on `o`'s surface, leaving out the triangles t with skip(t): the triangle
+/// of the exactly smallest distance (ties: the smallest id); none when every triangle is left
+/// out. With `stop_below` >= 0, the search may stop at a triangle whose distance is less than
+/// stop_below by more than the slack: its computed distance is then returned, for a caller
+/// that only needs to know that p's exact distance is less than that of a point at stop_below.
 template <typename Skip>
-std::pair<double, Vec3> nearest_point(const Vec3& p, const ObjectView& o, const Skip& skip,
-                                      double stop_at = -1) {
-  double best_sq = kInfinity;
-  Index best_t = kNoIndex;
-  Vec3 best_q = p;
+Nearest nearest_point(const Vec3& p, const ObjectView& o, double slack, const Skip& skip, double stop_below = -1) {
+  Nearest best;
+  Triangle best_triangle;
   bool stopped = false;
   AABB box;
   box.lo = box.hi = p;
   o.bvh->query(
-      box, [&] { return std::sqrt(best_sq); },
+      box, [&] { return best.distance + slack; },
       [&](Index t, double d2) {
-        if (stopped || d2 > best_sq || skip(t)) return;
-        const PointTriangleResult r = point_triangle_distance(p, o.object->triangle(t));
-        if (r.squared_distance < best_sq || (r.squared_distance == best_sq && t < best_t)) {
-          best_sq = r.squared_distance;
-          best_t = t;
-          best_q = r.closest;
-          stopped = stop_at >= 0 && std::sqrt(best_sq) <= stop_at;
+        const double reach = best.distance + slack;
+        if (stopped || d2 > reach * reach || skip(t)) return;
+        const Triangle tri = o.object->triangle(t);
+        const PointTriangleResult r = point_triangle_distance(p, tri);
+        const double d = std::sqrt(r.squared_distance);
+        if (best.triangle != kNoIndex) {
+          const int c = compare_distances(d, p, tri, best.distance, p, best_triangle, slack);
+          if (c > 0 || (c == 0 && t > best.triangle)) return;
         }
+        best = {d, r.closest, t};
+        best_triangle = tri;
+        stopped = stop_below >= 0 && d < stop_below - slack;
       },
       [&](std::int32_t) { return stopped; });
-  return {std::sqrt(best_sq), best_q};
+  return best;
 }
 
-std::pair<double, Vec3> nearest_point(const Vec3& p, const ObjectView& o, double stop_at = -1) {
-  return nearest_point(p, o, [](Index) { return false; }, stop_at);
-}
+/// The deepest vertex so far, and whether p at its nearest point `n` on `other` is strictly
+/// deeper (exactly; ties keep the earlier vertex).
+struct Deepest {
+  Nearest nearest;
+  Vec3 point = Vec3::Zero();
+  Triangle triangle{};
+  bool found = false;
+
+  bool deeper(const Vec3& p, const Nearest& n, const Object& other, double slack) const {
+    if (n.triangle == kNoIndex) return false;
+    if (!found) return true;
+    return compare_distances(n.distance, p, other.triangle(n.triangle), nearest.distance, point, triangle, slack) > 0;
+  }
+  void take(const Vec3& p, const Nearest& n, const Object& other) {
+    nearest = n;
+    point = p;
+    triangle = other.triangle(n.triangle);
+    found = true;
+  }
+};
 
 /// max - min of the projections of the points on the unit vector u.
 double width(const std::vector<Vec3>& points, const Vec3& u) {
@@ -628,14 +681,16 @@ PenetrationDepth self_contact_depth(SelfContext& ctx, Index object, const std::v
     pd.status = PdStatus::SelfIntersection;
     return pd;
   }
-  if (walk.swallowed) {
+  if (walk.swallowed) {  // as between objects: the inside vertices and step 2's triangles
     pd.inside_vertices = {walk.inside, {}};
+    pd.overlapping_triangles = {overlapping_triangles(o, hit, walk.inside), {}};
     pd.status = PdStatus::TooDeep;
     return pd;
   }
 
   // Own sheet R(C) of each inside component, nearest points outside it.
-  double best = -1;
+  const double slack = pd_slack(view.scale);
+  Deepest deepest;
   size_t deepest_component = 0;
   std::vector<std::vector<Index>> touching(walk.components.size());  // triangles touching C
   std::vector<std::vector<Index>> region_hits(walk.components.size());
@@ -695,19 +750,19 @@ PenetrationDepth self_contact_depth(SelfContext& ctx, Index object, const std::v
     std::sort(region_hits[c].begin(), region_hits[c].end());
     for (Index v : walk.components[c]) {
       const Vec3& p = o.positions[static_cast<size_t>(v)];
-      const auto [d, q] = nearest_point(p, view, in_region);
-      if (d == kInfinity) {  // the own sheet is the whole object
+      const Nearest near = nearest_point(p, view, slack, in_region);
+      if (near.triangle == kNoIndex) {  // the own sheet is the whole object
         undecided = true;
         break;
       }
-      if (d > best) {
-        best = d;
+      if (deepest.deeper(p, near, o, slack)) {
+        deepest.take(p, near, o);
         deepest_component = c;
         pd.deepest_object = object;
         pd.deepest_vertex = v;
         pd.deepest_point = p;
-        pd.nearest_point = q;
-        pd.direction = q - p;
+        pd.nearest_point = near.point;
+        pd.direction = near.point - p;
       }
     }
     if (undecided) break;
@@ -758,7 +813,7 @@ PenetrationDepth self_contact_depth(SelfContext& ctx, Index object, const std::v
   for (Index v : walk.inside) points.push_back(o.positions[static_cast<size_t>(v)]);
   // The overlapping faces of both sides are this object's; T = -n translates a face's
   // sheet back (the other sheet lies on its outward side).
-  return finish_depth(pd, best, points, {&o, &o}, {-1.0, -1.0});
+  return finish_depth(pd, deepest.found ? deepest.nearest.distance : -1.0, points, {&o, &o}, {-1.0, -1.0});
 }
 
 /// The entry of a self-intersecting object: its contacts (see above), reported as the first
@@ -856,24 +911,27 @@ PenetrationDepth pair_depth(const std::vector<ObjectView>& views,
     pd.status = PdStatus::TooDeep;
     return pd;
   }
-  // T: the inside vertex farthest from the other surface (ties: side 0 first, then the
-  // smallest vertex id), and the translation of objects[0] that takes it out. A vertex's
-  // search stops once it finds a point no farther than the deepest so far: it cannot be
-  // strictly deeper then (max-min; deep overlaps of fine meshes went as n^1.5 without it).
-  double best = -1;
+  // T: the inside vertex farthest from the other surface (exactly; ties: side 0 first, then
+  // the smallest vertex id), and the translation of objects[0] that takes it out. A vertex's
+  // search stops once it finds a point nearer than the deepest so far (by more than the
+  // slack): it cannot be deeper then (max-min; deep overlaps of fine meshes went as n^1.5
+  // without it).
+  const double slack = pd_slack(std::max(va.scale, vb.scale));
+  Deepest deepest;
   for (int side = 0; side < 2; ++side) {
     const ObjectView& own = side == 0 ? va : vb;
     const ObjectView& other = side == 0 ? vb : va;
     for (Index v : pd.inside_vertices[static_cast<size_t>(side)]) {
       const Vec3& p = own.object->positions[static_cast<size_t>(v)];
-      const auto [d, q] = nearest_point(p, other, best);
-      if (d > best) {
-        best = d;
+      const Nearest near = nearest_point(
+          p, other, slack, [](Index) { return false; }, deepest.found ? deepest.nearest.distance : -1.0);
+      if (deepest.deeper(p, near, *other.object, slack)) {
+        deepest.take(p, near, *other.object);
         pd.deepest_object = side == 0 ? ia : ib;
         pd.deepest_vertex = v;
         pd.deepest_point = p;
-        pd.nearest_point = q;
-        pd.direction = side == 0 ? Vec3(q - p) : Vec3(p - q);
+        pd.nearest_point = near.point;
+        pd.direction = side == 0 ? Vec3(near.point - p) : Vec3(p - near.point);
       }
     }
   }
@@ -884,7 +942,8 @@ PenetrationDepth pair_depth(const std::vector<ObjectView>& views,
   for (Index v : wa.inside) points.push_back(va.object->positions[static_cast<size_t>(v)]);
   for (Index v : wb.inside) points.push_back(vb.object->positions[static_cast<size_t>(v)]);
   // Face normals point out of B: +n for B's faces, -n for A's (outward normals).
-  return finish_depth(pd, best, points, {va.object, vb.object}, {-1.0, 1.0});
+  return finish_depth(pd, deepest.found ? deepest.nearest.distance : -1.0, points, {va.object, vb.object},
+                      {-1.0, 1.0});
 }
 
 }  // namespace
@@ -925,7 +984,7 @@ PenetrationDepthOutput penetration_depth(const Frame& frame, const FrameBoxes& b
   std::vector<ObjectView> views(n);
   parallel_for(n, threads, [&](size_t i) {
     if (!involved[i]) return;
-    views[i] = {&frame.objects[i], &boxes.bvh(i)};
+    views[i] = {&frame.objects[i], &boxes.bvh(i), coordinate_scale(frame.objects[i])};
     surface[i] = surface_status(*frame.objects[i].topology);
   });
   out.pairs.resize(runs.size());

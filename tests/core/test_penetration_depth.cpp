@@ -4,14 +4,17 @@
 // self-intersecting objects against analytic depths and against the same geometry as
 // separate objects (the inter-object twin).
 #include "core/query/intersecting_pairs.hpp"
+#include "core/geometry/exact_distance.hpp"
 #include "core/geometry/point_triangle.hpp"
 #include "core/mesh/adjacency.hpp"
 #include "core/query/penetration_depth.hpp"
 #include "support/random_scene.hpp"
+#include "support/rng.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <map>
 
 namespace vproxq {
@@ -368,36 +371,180 @@ TEST(PenetrationDepth, IcospheresWithinSamplingError) {
   }
 }
 
-// The deepest vertex is the inside vertex farthest from the other surface (ties: objects[0]'s
-// side first, then the smallest vertex id), each distance here from every triangle of the other
-// object: the search's early stop (a vertex no deeper than the deepest so far) changes nothing.
+/// The deepest vertex of an entry by brute force in exact arithmetic, as the README defines it:
+/// each inside vertex's exact distance to every triangle of the other object (its nearest
+/// point on the lowest-numbered of equally near triangles), the largest of them (ties:
+/// objects[0]'s vertices first, then the smallest vertex id). For speed, only triangles (and
+/// vertices) whose double-precision distance is within 1e-6 of the nearest (the deepest) are
+/// compared exactly: a margin millions of times the rounding.
+struct ExactDeepest {
+  Index object = kNoIndex, vertex = kNoIndex;
+  Vec3 nearest = Vec3::Zero();
+  int tied = 0;  ///< inside vertices exactly as deep as the deepest (itself included)
+};
+ExactDeepest exact_deepest(const Frame& frame, const PenetrationDepth& pd) {
+  constexpr double kMargin = 1e-6;
+  struct Candidate {
+    Index object, vertex;
+    Vec3 point;
+    Index face;
+    double distance;
+  };
+  std::vector<Candidate> all;
+  for (size_t side = 0; side < 2; ++side) {
+    const Object& other = frame.objects[static_cast<size_t>(pd.objects[1 - side])];
+    for (Index v : pd.inside_vertices[side]) {
+      const Vec3& p = frame.objects[static_cast<size_t>(pd.objects[side])].positions[static_cast<size_t>(v)];
+      std::vector<double> d(static_cast<size_t>(other.num_triangles()));
+      for (Index t = 0; t < other.num_triangles(); ++t)
+        d[static_cast<size_t>(t)] = std::sqrt(point_triangle_distance(p, other.triangle(t)).squared_distance);
+      const double least = *std::min_element(d.begin(), d.end());
+      Index face = kNoIndex;
+      ExactFraction nearest;
+      for (Index t = 0; t < other.num_triangles(); ++t) {
+        if (d[static_cast<size_t>(t)] > least + kMargin) continue;
+        ExactFraction e = exact_point_triangle_squared_distance(p, other.triangle(t));
+        if (face == kNoIndex || compare(e, nearest) < 0) {
+          nearest = std::move(e);
+          face = t;
+        }
+      }
+      all.push_back({pd.objects[side], v, p, face, least});
+    }
+  }
+  ExactDeepest out;
+  if (all.empty()) return out;
+  double most = 0;
+  for (const Candidate& c : all) most = std::max(most, c.distance);
+  ExactFraction deepest;
+  for (const Candidate& c : all) {  // objects[0]'s side first, vertices ascending
+    if (c.distance < most - kMargin) continue;
+    const Object& other = frame.objects[static_cast<size_t>(c.object == pd.objects[0] ? pd.objects[1] : pd.objects[0])];
+    ExactFraction e = exact_point_triangle_squared_distance(c.point, other.triangle(c.face));
+    const int order = out.vertex == kNoIndex ? 1 : compare(e, deepest);
+    if (order > 0) {
+      deepest = std::move(e);
+      out = {c.object, c.vertex, point_triangle_distance(c.point, other.triangle(c.face)).closest, 1};
+    } else if (order == 0) {
+      ++out.tied;
+    }
+  }
+  return out;
+}
+
+// The deepest vertex against the exact brute force: the search's early stop (a vertex nearer
+// than the deepest so far) and its pruning by boxes change nothing.
 TEST(PenetrationDepth, DeepestVertexIsTheBruteForceMaxMin) {
   for (const Vec3& c2 : {Vec3(0.9, 0.1, 0.0), Vec3(0.4, 0.3, -0.2), Vec3(1.2, 0.5, 0.3)}) {
     const Frame frame = frame_of({make_icosphere(Vec3(0, 0, 0), 1.0, 3, "s1"), make_icosphere(c2, 0.8, 3, "s2")});
     const auto pd = run_pd(frame);
     ASSERT_EQ(pd.size(), 1u);
     ASSERT_EQ(pd[0].status, PdStatus::Ok) << pd_status_name(pd[0].status);
-    double best = -1;
-    int best_side = -1;
-    Index best_vertex = kNoIndex;
-    for (int side = 0; side < 2; ++side) {
-      const Object& own = frame.objects[static_cast<size_t>(side)];
-      const Object& other = frame.objects[static_cast<size_t>(1 - side)];
-      for (Index v : pd[0].inside_vertices[static_cast<size_t>(side)]) {
-        double d2 = kInfinity;
-        for (Index t = 0; t < other.num_triangles(); ++t)
-          d2 = std::min(d2, point_triangle_distance(own.positions[static_cast<size_t>(v)], other.triangle(t)).squared_distance);
-        if (std::sqrt(d2) > best) {
-          best = std::sqrt(d2);
-          best_side = side;
-          best_vertex = v;
-        }
+    const ExactDeepest expected = exact_deepest(frame, pd[0]);
+    ASSERT_NE(expected.vertex, kNoIndex);
+    EXPECT_EQ(pd[0].deepest_object, expected.object);
+    EXPECT_EQ(pd[0].deepest_vertex, expected.vertex);
+    EXPECT_EQ(pd[0].nearest_point, expected.nearest);
+  }
+}
+
+// Boxes on a dyadic grid (every coordinate exact in binary): inside vertices are often
+// exactly equally deep, and equally near several faces. Double precision rounds such ties
+// either way (a vertex 0.25 from a face computed 0.24999999999999997 from it lost to another
+// vertex 0.25 from a face computed exactly): the deepest vertex, its nearest point and so T
+// must follow the README's tie rules, decided exactly (an independent exact-rational oracle
+// found 19 entries out of about 2,450 that did not).
+TEST(PenetrationDepth, ExactTiesFollowTheTieRules) {
+  test::Rng rng(2024);
+  int tied = 0, entries = 0;
+  for (int trial = 0; trial < 600; ++trial) {
+    std::vector<Object> boxes;
+    for (int k = 0; k < 2; ++k) {
+      Vec3 lo, size;
+      std::array<int, 3> counts{};
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = rng.integer(0, 8) / 4.0;
+        size[a] = rng.integer(2, 8) / 4.0;
+        counts[static_cast<size_t>(a)] = 1 << rng.integer(0, 2);
       }
+      boxes.push_back(make_grid_box(lo, size, counts).object);
     }
-    ASSERT_GE(best_side, 0);
-    EXPECT_EQ(pd[0].deepest_object, best_side);
-    EXPECT_EQ(pd[0].deepest_vertex, best_vertex);
-    EXPECT_NEAR((pd[0].deepest_point - pd[0].nearest_point).norm(), best, 1e-12);
+    const Frame frame = frame_of(boxes);
+    for (const PenetrationDepth& pd : run_pd(frame)) {
+      if (pd.status != PdStatus::Ok || pd.deepest_vertex == kNoIndex) continue;
+      ++entries;
+      const ExactDeepest expected = exact_deepest(frame, pd);
+      EXPECT_EQ(pd.deepest_object, expected.object) << "trial " << trial;
+      EXPECT_EQ(pd.deepest_vertex, expected.vertex) << "trial " << trial;
+      EXPECT_EQ(pd.nearest_point, expected.nearest) << "trial " << trial;
+      tied += expected.tied > 1;
+    }
+  }
+  std::printf("[ ties ] %d pd entries, %d with exactly equally deep vertices\n", entries, tied);
+  EXPECT_GT(entries, 150);
+  EXPECT_GT(tied, 50);  // the construction does make ties
+}
+
+/// An object from corner positions and 0-based faces.
+Object literal_object(std::vector<Vec3> positions, std::vector<Face> faces, const std::string& name) {
+  Object o;
+  auto topo = std::make_shared<Topology>();
+  topo->num_vertices = static_cast<Index>(positions.size());
+  topo->faces = std::move(faces);
+  o.topology = topo;
+  o.positions = std::move(positions);
+  o.name = name;
+  return o;
+}
+
+/// Faces of a 12-triangle box whose corners are numbered (x, y, z) -> 4 (1 - x) + 2 y + z.
+const std::vector<Face> kBoxFaces = {{0, 2, 3}, {0, 3, 1}, {4, 7, 6}, {4, 5, 7}, {6, 7, 3}, {6, 3, 2},
+                                     {4, 1, 5}, {4, 0, 1}, {5, 1, 3}, {5, 3, 7}, {4, 2, 0}, {4, 6, 2}};
+Object literal_box(const Vec3& lo, const Vec3& hi, const std::string& name) {
+  std::vector<Vec3> corners;
+  for (int x : {1, 0})
+    for (int y : {0, 1})
+      for (int z : {0, 1}) corners.emplace_back(x ? hi.x() : lo.x(), y ? hi.y() : lo.y(), z ? hi.z() : lo.z());
+  return literal_object(corners, kBoxFaces, name);
+}
+
+// The two cases the exact oracle reported, worked out by hand from the README's rules.
+TEST(PenetrationDepth, ExactTiesOfTheOracle) {
+  {  // one inside vertex, b's corner 3 = (1.75, 1.25, 1.5), exactly 0.5 from a's faces 1
+     // (x = 2.25), 7 (y = 0.75), 8 (z = 2) and 10 (z = 1): the nearest point is on face 1,
+     // b moves by -T = +x, the overlap is 1.75 - 0.5 wide along x.
+    const Frame frame = frame_of({literal_box(Vec3(0.5, 0.75, 1), Vec3(2.25, 2.5, 2), "a"),
+                                  literal_box(Vec3(0.5, 0.75, 0.75), Vec3(1.75, 1.25, 1.5), "b")});
+    const auto pd = run_pd(frame);
+    ASSERT_EQ(pd.size(), 1u);
+    ASSERT_EQ(pd[0].status, PdStatus::Ok);
+    EXPECT_EQ(pd[0].deepest_object, 1);
+    EXPECT_EQ(pd[0].deepest_vertex, 3);
+    EXPECT_EQ(pd[0].nearest_point, Vec3(2.25, 1.25, 1.5));
+    EXPECT_EQ(pd[0].direction, Vec3(-1, 0, 0));
+    EXPECT_EQ(pd[0].depth, 1.25);
+  }
+  {  // b (a 1 x 2 x 1 grid box) has three inside corners, (2.25, y, 2) for y = 0.5, 0.75, 1,
+     // each exactly 0.25 from a (the first also from a's face y = 0.25, computed
+     // 0.24999999999999997): the smallest id wins, its nearest point is on y = 0.25, and the
+     // overlap is 1 - 0.5 wide along y.
+    const std::vector<Vec3> b_corners = {{2.25, 0.5, 0.25}, {2.25, 0.5, 2.0}, {2.25, 0.75, 0.25}, {2.25, 0.75, 2.0},
+                                         {2.25, 1.0, 0.25}, {2.25, 1.0, 2.0}, {1.0, 0.5, 0.25},   {1.0, 0.5, 2.0},
+                                         {1.0, 0.75, 0.25}, {1.0, 0.75, 2.0}, {1.0, 1.0, 0.25},   {1.0, 1.0, 2.0}};
+    const std::vector<Face> b_faces = {{0, 2, 3},  {0, 3, 1},  {2, 4, 5},  {2, 5, 3},  {6, 9, 8},  {6, 7, 9},  {8, 11, 10},
+                                       {8, 9, 11}, {10, 11, 5}, {10, 5, 4}, {6, 1, 7},  {6, 0, 1},  {7, 1, 3},  {7, 3, 9},
+                                       {9, 3, 5},  {9, 5, 11}, {6, 2, 0},  {6, 8, 2},  {8, 4, 2},  {8, 10, 4}};
+    const Frame frame = frame_of({literal_box(Vec3(1.25, 0.25, 0.5), Vec3(3, 1.5, 2.25), "a"),
+                                  literal_object(b_corners, b_faces, "b")});
+    const auto pd = run_pd(frame);
+    ASSERT_EQ(pd.size(), 1u);
+    ASSERT_EQ(pd[0].status, PdStatus::Ok);
+    EXPECT_EQ(pd[0].inside_vertices[1], (std::vector<Index>{1, 3, 5}));
+    EXPECT_EQ(pd[0].deepest_object, 1);
+    EXPECT_EQ(pd[0].deepest_vertex, 1);
+    EXPECT_EQ(pd[0].nearest_point, Vec3(2.25, 0.25, 2));
+    EXPECT_EQ(pd[0].direction, Vec3(0, 1, 0));
+    EXPECT_EQ(pd[0].depth, 0.5);
   }
 }
 
@@ -782,6 +929,20 @@ TEST(PenetrationDepthSelf, UndefinedCasesGetAStatus) {
     const auto pd = run_pd(frame_of({merge({big, small}, "nested")}));
     ASSERT_EQ(pd.size(), 1u);
     EXPECT_EQ(pd[0].status, PdStatus::TooDeep) << pd_status_name(pd[0].status);
+    // It lists what the two objects' entry lists: the inside vertices, and the intersecting
+    // triangles with those touching an inside vertex (small's triangles touch only inside
+    // vertices and intersect nothing but the dent).
+    const auto twin = run_pd(frame_of({big, small}));
+    ASSERT_EQ(twin.size(), 1u);
+    EXPECT_EQ(twin[0].status, PdStatus::TooDeep);
+    std::vector<Index> vertices = twin[0].inside_vertices[0], triangles = twin[0].overlapping_triangles[0];
+    for (Index v : twin[0].inside_vertices[1]) vertices.push_back(v + big.num_vertices());
+    for (Index t : twin[0].overlapping_triangles[1]) triangles.push_back(t + big.num_triangles());
+    std::sort(vertices.begin(), vertices.end());
+    std::sort(triangles.begin(), triangles.end());
+    EXPECT_EQ(pd[0].inside_vertices[0], vertices);
+    EXPECT_EQ(pd[0].overlapping_triangles[0], triangles);
+    EXPECT_EQ(static_cast<Index>(twin[0].overlapping_triangles[1].size()), small.num_triangles());
   }
 }
 
