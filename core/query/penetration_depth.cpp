@@ -513,14 +513,19 @@ Nearest nearest_point(const Vec3& p, const ObjectView& o, double slack, const Sk
         if (stopped || d2 > reach * reach || skip(t)) return;
         const Triangle tri = o.object->triangle(t);
         const PointTriangleResult r = point_triangle_distance(p, tri);
-        const double d = std::sqrt(r.squared_distance);
         if (best.triangle != kNoIndex) {
-          const int c = compare_distances(d, p, tri, best.distance, p, best_triangle, slack);
-          if (c > 0 || (c == 0 && t > best.triangle)) return;
+          // compare_distances, in squares (no square root for the many farther triangles).
+          if (r.squared_distance > reach * reach) return;
+          const double below = best.distance - slack;
+          if (!(below > 0 && r.squared_distance < below * below)) {
+            const int c = compare(exact_point_triangle_squared_distance(p, tri),
+                                  exact_point_triangle_squared_distance(p, best_triangle));
+            if (c > 0 || (c == 0 && t > best.triangle)) return;
+          }
         }
-        best = {d, r.closest, t};
+        best = {std::sqrt(r.squared_distance), r.closest, t};
         best_triangle = tri;
-        stopped = stop_below >= 0 && d < stop_below - slack;
+        stopped = stop_below >= 0 && best.distance < stop_below - slack;
       },
       [&](std::int32_t) { return stopped; });
   return best;
