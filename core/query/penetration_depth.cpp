@@ -470,15 +470,35 @@ struct Nearest {
   Index triangle = kNoIndex;
 };
 
-/// The order of two points' exact squared distances to two triangles (a nearest triangle of
-/// each): sign(d(p, s) - d(q, u)). Computed distances farther apart than `slack` decide it
-/// (slack is far above the rounding of point_triangle_distance: see pd_slack); nearer ones, in
-/// particular exact ties, are decided in exact arithmetic.
-int compare_distances(double dp, const Vec3& p, const Triangle& s, double dq, const Vec3& q, const Triangle& u,
-                      double slack) {
-  if (dp < dq - slack) return -1;
-  if (dp > dq + slack) return 1;
-  return compare(exact_point_triangle_squared_distance(p, s), exact_point_triangle_squared_distance(q, u));
+/// An exact squared point-triangle distance, computed when first needed (exact arithmetic is
+/// slow, and only near ties need it).
+class LazyExact {
+ public:
+  LazyExact() = default;
+  LazyExact(const Vec3& p, const Triangle& t) : p_(p), t_(t) {}
+  const ExactFraction& value() {
+    if (!done_) {
+      value_ = exact_point_triangle_squared_distance(p_, t_);
+      done_ = true;
+    }
+    return value_;
+  }
+
+ private:
+  Vec3 p_ = Vec3::Zero();
+  Triangle t_{};
+  ExactFraction value_;
+  bool done_ = false;
+};
+
+/// sign(a - b) for two squared point-triangle distances whose computed distances are da and
+/// db: computed distances farther apart than `slack` decide it (slack is far above the
+/// rounding of point_triangle_distance: see pd_slack); nearer ones, in particular exact ties,
+/// are decided in exact arithmetic.
+int compare_distances(double da, LazyExact& a, double db, LazyExact& b, double slack) {
+  if (da < db - slack) return -1;
+  if (da > db + slack) return 1;
+  return compare(a.value(), b.value());
 }
 
 /// The slack of compare_distances for points and triangles of objects whose coordinates are
@@ -502,7 +522,7 @@ double coordinate_scale(const Object& o) {
 template <typename Skip>
 Nearest nearest_point(const Vec3& p, const ObjectView& o, double slack, const Skip& skip, double stop_below = -1) {
   Nearest best;
-  Triangle best_triangle;
+  LazyExact best_exact;
   bool stopped = false;
   AABB box;
   box.lo = box.hi = p;
@@ -518,13 +538,17 @@ Nearest nearest_point(const Vec3& p, const ObjectView& o, double slack, const Sk
           if (r.squared_distance > reach * reach) return;
           const double below = best.distance - slack;
           if (!(below > 0 && r.squared_distance < below * below)) {
-            const int c = compare(exact_point_triangle_squared_distance(p, tri),
-                                  exact_point_triangle_squared_distance(p, best_triangle));
+            LazyExact exact(p, tri);
+            const int c = compare(exact.value(), best_exact.value());
             if (c > 0 || (c == 0 && t > best.triangle)) return;
+            best = {std::sqrt(r.squared_distance), r.closest, t};
+            best_exact = std::move(exact);
+            stopped = stop_below >= 0 && best.distance < stop_below - slack;
+            return;
           }
         }
         best = {std::sqrt(r.squared_distance), r.closest, t};
-        best_triangle = tri;
+        best_exact = LazyExact(p, tri);
         stopped = stop_below >= 0 && best.distance < stop_below - slack;
       },
       [&](std::int32_t) { return stopped; });
@@ -535,19 +559,18 @@ Nearest nearest_point(const Vec3& p, const ObjectView& o, double slack, const Sk
 /// deeper (exactly; ties keep the earlier vertex).
 struct Deepest {
   Nearest nearest;
-  Vec3 point = Vec3::Zero();
-  Triangle triangle{};
+  LazyExact exact;
   bool found = false;
 
-  bool deeper(const Vec3& p, const Nearest& n, const Object& other, double slack) const {
+  bool deeper(const Vec3& p, const Nearest& n, const Object& other, double slack) {
     if (n.triangle == kNoIndex) return false;
     if (!found) return true;
-    return compare_distances(n.distance, p, other.triangle(n.triangle), nearest.distance, point, triangle, slack) > 0;
+    LazyExact candidate(p, other.triangle(n.triangle));
+    return compare_distances(n.distance, candidate, nearest.distance, exact, slack) > 0;
   }
   void take(const Vec3& p, const Nearest& n, const Object& other) {
     nearest = n;
-    point = p;
-    triangle = other.triangle(n.triangle);
+    exact = LazyExact(p, other.triangle(n.triangle));
     found = true;
   }
 };
