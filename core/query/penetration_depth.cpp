@@ -126,7 +126,7 @@ int winding_number(const Vec3& p, const Object& o, const TriangleBvh& bvh, bool&
 struct ObjectView {
   const Object* object;
   const TriangleBvh* bvh;
-  double scale;  ///< the largest coordinate magnitude of the object
+  double scale;  ///< the largest coordinate magnitude of the object's triangles (FrameBoxes)
 };
 
 /// The symbolic point q above, from v inside the star face (v, n1, n2).
@@ -507,13 +507,6 @@ int compare_distances(double da, LazyExact& a, double db, LazyExact& b, double s
 /// distances more than the slack apart are ordered as the exact ones are.
 double pd_slack(double scale) { return 0x1p-40 * scale; }
 
-/// The largest coordinate magnitude of an object.
-double coordinate_scale(const Object& o) {
-  double s = 0;
-  for (const Vec3& v : o.positions) s = std::max(s, v.cwiseAbs().maxCoeff());
-  return s;
-}
-
 /// p's nearest point on `o`'s surface, leaving out the triangles t with skip(t): the triangle
 /// of the exactly smallest distance (ties: the smallest id); none when every triangle is left
 /// out. With `stop_below` >= 0, the search may stop at a triangle whose distance is less than
@@ -533,22 +526,14 @@ Nearest nearest_point(const Vec3& p, const ObjectView& o, double slack, const Sk
         if (stopped || d2 > reach * reach || skip(t)) return;
         const Triangle tri = o.object->triangle(t);
         const PointTriangleResult r = point_triangle_distance(p, tri);
+        const double d = std::sqrt(r.squared_distance);
+        LazyExact exact(p, tri);
         if (best.triangle != kNoIndex) {
-          // compare_distances, in squares (no square root for the many farther triangles).
-          if (r.squared_distance > reach * reach) return;
-          const double below = best.distance - slack;
-          if (!(below > 0 && r.squared_distance < below * below)) {
-            LazyExact exact(p, tri);
-            const int c = compare(exact.value(), best_exact.value());
-            if (c > 0 || (c == 0 && t > best.triangle)) return;
-            best = {std::sqrt(r.squared_distance), r.closest, t};
-            best_exact = std::move(exact);
-            stopped = stop_below >= 0 && best.distance < stop_below - slack;
-            return;
-          }
+          const int c = compare_distances(d, exact, best.distance, best_exact, slack);
+          if (c > 0 || (c == 0 && t > best.triangle)) return;
         }
-        best = {std::sqrt(r.squared_distance), r.closest, t};
-        best_exact = LazyExact(p, tri);
+        best = {d, r.closest, t};
+        best_exact = std::move(exact);
         stopped = stop_below >= 0 && best.distance < stop_below - slack;
       },
       [&](std::int32_t) { return stopped; });
@@ -1012,7 +997,7 @@ PenetrationDepthOutput penetration_depth(const Frame& frame, const FrameBoxes& b
   std::vector<ObjectView> views(n);
   parallel_for(n, threads, [&](size_t i) {
     if (!involved[i]) return;
-    views[i] = {&frame.objects[i], &boxes.bvh(i), coordinate_scale(frame.objects[i])};
+    views[i] = {&frame.objects[i], &boxes.bvh(i), boxes.magnitudes[i]};
     surface[i] = surface_status(*frame.objects[i].topology);
   });
   out.pairs.resize(runs.size());
