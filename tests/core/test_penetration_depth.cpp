@@ -8,6 +8,7 @@
 #include "core/geometry/point_triangle.hpp"
 #include "core/mesh/adjacency.hpp"
 #include "core/query/penetration_depth.hpp"
+#include "support/pd_checks.hpp"
 #include "support/random_scene.hpp"
 #include "support/rng.hpp"
 
@@ -371,67 +372,6 @@ TEST(PenetrationDepth, IcospheresWithinSamplingError) {
   }
 }
 
-/// The deepest vertex of an entry by brute force in exact arithmetic, as the README defines it:
-/// each inside vertex's exact distance to every triangle of the other object (its nearest
-/// point on the lowest-numbered of equally near triangles), the largest of them (ties:
-/// objects[0]'s vertices first, then the smallest vertex id). For speed, only triangles (and
-/// vertices) whose double-precision distance is within 1e-6 of the nearest (the deepest) are
-/// compared exactly: a margin millions of times the rounding.
-struct ExactDeepest {
-  Index object = kNoIndex, vertex = kNoIndex;
-  Vec3 nearest = Vec3::Zero();
-  int tied = 0;  ///< inside vertices exactly as deep as the deepest (itself included)
-};
-ExactDeepest exact_deepest(const Frame& frame, const PenetrationDepth& pd) {
-  constexpr double kMargin = 1e-6;
-  struct Candidate {
-    Index object, vertex;
-    Vec3 point;
-    Index face;
-    double distance;
-  };
-  std::vector<Candidate> all;
-  for (size_t side = 0; side < 2; ++side) {
-    const Object& other = frame.objects[static_cast<size_t>(pd.objects[1 - side])];
-    for (Index v : pd.inside_vertices[side]) {
-      const Vec3& p = frame.objects[static_cast<size_t>(pd.objects[side])].positions[static_cast<size_t>(v)];
-      std::vector<double> d(static_cast<size_t>(other.num_triangles()));
-      for (Index t = 0; t < other.num_triangles(); ++t)
-        d[static_cast<size_t>(t)] = std::sqrt(point_triangle_distance(p, other.triangle(t)).squared_distance);
-      const double least = *std::min_element(d.begin(), d.end());
-      Index face = kNoIndex;
-      ExactFraction nearest;
-      for (Index t = 0; t < other.num_triangles(); ++t) {
-        if (d[static_cast<size_t>(t)] > least + kMargin) continue;
-        ExactFraction e = exact_point_triangle_squared_distance(p, other.triangle(t));
-        if (face == kNoIndex || compare(e, nearest) < 0) {
-          nearest = std::move(e);
-          face = t;
-        }
-      }
-      all.push_back({pd.objects[side], v, p, face, least});
-    }
-  }
-  ExactDeepest out;
-  if (all.empty()) return out;
-  double most = 0;
-  for (const Candidate& c : all) most = std::max(most, c.distance);
-  ExactFraction deepest;
-  for (const Candidate& c : all) {  // objects[0]'s side first, vertices ascending
-    if (c.distance < most - kMargin) continue;
-    const Object& other = frame.objects[static_cast<size_t>(c.object == pd.objects[0] ? pd.objects[1] : pd.objects[0])];
-    ExactFraction e = exact_point_triangle_squared_distance(c.point, other.triangle(c.face));
-    const int order = out.vertex == kNoIndex ? 1 : compare(e, deepest);
-    if (order > 0) {
-      deepest = std::move(e);
-      out = {c.object, c.vertex, point_triangle_distance(c.point, other.triangle(c.face)).closest, 1};
-    } else if (order == 0) {
-      ++out.tied;
-    }
-  }
-  return out;
-}
-
 // The deepest vertex against the exact brute force: the search's early stop (a vertex nearer
 // than the deepest so far) and its pruning by boxes change nothing.
 TEST(PenetrationDepth, DeepestVertexIsTheBruteForceMaxMin) {
@@ -440,7 +380,7 @@ TEST(PenetrationDepth, DeepestVertexIsTheBruteForceMaxMin) {
     const auto pd = run_pd(frame);
     ASSERT_EQ(pd.size(), 1u);
     ASSERT_EQ(pd[0].status, PdStatus::Ok) << pd_status_name(pd[0].status);
-    const ExactDeepest expected = exact_deepest(frame, pd[0]);
+    const test::ExactDeepest expected = test::exact_deepest(frame, pd[0]);
     ASSERT_NE(expected.vertex, kNoIndex);
     EXPECT_EQ(pd[0].deepest_object, expected.object);
     EXPECT_EQ(pd[0].deepest_vertex, expected.vertex);
@@ -473,7 +413,7 @@ TEST(PenetrationDepth, ExactTiesFollowTheTieRules) {
     for (const PenetrationDepth& pd : run_pd(frame)) {
       if (pd.status != PdStatus::Ok || pd.deepest_vertex == kNoIndex) continue;
       ++entries;
-      const ExactDeepest expected = exact_deepest(frame, pd);
+      const test::ExactDeepest expected = test::exact_deepest(frame, pd);
       EXPECT_EQ(pd.deepest_object, expected.object) << "trial " << trial;
       EXPECT_EQ(pd.deepest_vertex, expected.vertex) << "trial " << trial;
       EXPECT_EQ(pd.nearest_point, expected.nearest) << "trial " << trial;
@@ -553,15 +493,7 @@ TEST(PenetrationDepth, ThreadCountDoesNotChangeResults) {
                                 make_box(Vec3(0.5, -0.3, -0.2), Vec3(1.2, 0.5, 0.4), 3, "box")});
   const auto a = run_pd(frame, 1), b = run_pd(frame, 3);
   ASSERT_EQ(a.size(), 3u);
-  ASSERT_EQ(a.size(), b.size());
-  for (size_t k = 0; k < a.size(); ++k) {
-    EXPECT_EQ(a[k].objects, b[k].objects);
-    EXPECT_EQ(a[k].status, b[k].status);
-    EXPECT_EQ(a[k].depth, b[k].depth);
-    EXPECT_EQ(a[k].direction, b[k].direction);
-    EXPECT_EQ(a[k].inside_vertices, b[k].inside_vertices);
-    EXPECT_EQ(a[k].overlapping_triangles, b[k].overlapping_triangles);
-  }
+  test::expect_same_pd(a, b, "threads 1 vs 3");
 }
 
 TEST(PenetrationDepth, UndefinedCasesGetAStatus) {
@@ -639,31 +571,7 @@ TEST(PenetrationDepth, InsideVerticesAreTheWalkClosureOfBruteForceWinding) {
         EXPECT_GE(e.depth, 0.0);
         EXPECT_NEAR(e.direction.norm(), 1.0, 1e-12);
       }
-      for (int side = 0; side < 2; ++side) {
-        const Object& own = frame.objects[static_cast<size_t>(e.objects[static_cast<size_t>(side)])];
-        const Object& other = frame.objects[static_cast<size_t>(e.objects[static_cast<size_t>(1 - side)])];
-        auto inside = [&](Index v) {
-          bool on = false;
-          const int w = winding_number_brute_force(own.positions[static_cast<size_t>(v)], other, on);
-          return !on && w != 0;
-        };
-        const auto& list = e.inside_vertices[static_cast<size_t>(side)];
-        auto listed = [&](Index v) { return std::binary_search(list.begin(), list.end(), v); };
-        for (Index v : list) EXPECT_TRUE(inside(v)) << "vertex " << v;
-        for (const IntersectingPair& p : pairs) {  // seeds
-          if (p.object_a != e.objects[0] || p.object_b != e.objects[1]) continue;
-          for (Index v : own.topology->faces[static_cast<size_t>(side == 0 ? p.tri_a : p.tri_b)])
-            EXPECT_EQ(listed(v), inside(v)) << "seed vertex " << v;
-        }
-        const Adjacency& adj = adjacency(*own.topology);
-        for (Index v : list)  // closed under inside neighbours
-          for (Index t : adj.vertex_triangles(v))
-            for (Index u : own.topology->faces[static_cast<size_t>(t)])
-              if (!listed(u)) {
-                EXPECT_FALSE(inside(u)) << "neighbour " << u << " of " << v;
-              }
-        checked += list.size();
-      }
+      checked += test::expect_inside_is_walk_closure(frame, e, pairs);
     }
   }
   std::printf("[ blobs ] %zu pd entries ok, %zu inside vertices checked\n", ok, checked);

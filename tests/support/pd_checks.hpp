@@ -1,0 +1,142 @@
+#pragma once
+// Brute-force checks of penetration-depth entries between two objects, shared by the PD tests
+// (tests/core/test_penetration_depth.cpp) and the PD fuzz harness (tests/fuzz/fuzz_pd.cpp):
+// the deepest vertex by exact max-min over every face, the inside vertices against the
+// brute-force winding number, and the comparison of two results field by field.
+#include "core/geometry/exact_distance.hpp"
+#include "core/geometry/point_triangle.hpp"
+#include "core/mesh/adjacency.hpp"
+#include "core/query/penetration_depth.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace vproxq::test {
+
+/// The deepest vertex of an entry between two objects by brute force in exact arithmetic, as
+/// the README defines it: each inside vertex's exact distance to every triangle of the other
+/// object (its nearest point on the lowest-numbered of equally near triangles), the largest of
+/// them (ties: objects[0]'s vertices first, then the smallest vertex id). For speed, only
+/// triangles (and vertices) whose double-precision distance is within a margin of the nearest
+/// (the deepest) are compared exactly: 2^-30 of the largest coordinate magnitude, which is
+/// hundreds of thousands of times the rounding of a computed distance.
+struct ExactDeepest {
+  Index object = kNoIndex, vertex = kNoIndex;
+  Vec3 nearest = Vec3::Zero();
+  int tied = 0;  ///< inside vertices exactly as deep as the deepest (itself included)
+};
+inline ExactDeepest exact_deepest(const Frame& frame, const PenetrationDepth& pd) {
+  double magnitude = 0;
+  for (Index k : pd.objects)
+    for (const Vec3& p : frame.objects[static_cast<size_t>(k)].positions) magnitude = std::max(magnitude, p.cwiseAbs().maxCoeff());
+  const double margin = 0x1p-30 * magnitude;
+  struct Candidate {
+    Index object, vertex;
+    Vec3 point;
+    Index face;
+    double distance;
+  };
+  std::vector<Candidate> all;
+  for (size_t side = 0; side < 2; ++side) {
+    const Object& other = frame.objects[static_cast<size_t>(pd.objects[1 - side])];
+    for (Index v : pd.inside_vertices[side]) {
+      const Vec3& p = frame.objects[static_cast<size_t>(pd.objects[side])].positions[static_cast<size_t>(v)];
+      std::vector<double> d(static_cast<size_t>(other.num_triangles()));
+      for (Index t = 0; t < other.num_triangles(); ++t)
+        d[static_cast<size_t>(t)] = std::sqrt(point_triangle_distance(p, other.triangle(t)).squared_distance);
+      const double least = *std::min_element(d.begin(), d.end());
+      Index face = kNoIndex;
+      ExactFraction nearest;
+      for (Index t = 0; t < other.num_triangles(); ++t) {
+        if (d[static_cast<size_t>(t)] > least + margin) continue;
+        ExactFraction e = exact_point_triangle_squared_distance(p, other.triangle(t));
+        if (face == kNoIndex || compare(e, nearest) < 0) {
+          nearest = std::move(e);
+          face = t;
+        }
+      }
+      all.push_back({pd.objects[side], v, p, face, least});
+    }
+  }
+  ExactDeepest out;
+  if (all.empty()) return out;
+  double most = 0;
+  for (const Candidate& c : all) most = std::max(most, c.distance);
+  ExactFraction deepest;
+  for (const Candidate& c : all) {  // objects[0]'s side first, vertices ascending
+    if (c.distance < most - margin) continue;
+    const Object& other = frame.objects[static_cast<size_t>(c.object == pd.objects[0] ? pd.objects[1] : pd.objects[0])];
+    ExactFraction e = exact_point_triangle_squared_distance(c.point, other.triangle(c.face));
+    const int order = out.vertex == kNoIndex ? 1 : compare(e, deepest);
+    if (order > 0) {
+      deepest = std::move(e);
+      out = {c.object, c.vertex, point_triangle_distance(c.point, other.triangle(c.face)).closest, 1};
+    } else if (order == 0) {
+      ++out.tied;
+    }
+  }
+  return out;
+}
+
+/// Checks the inside vertices of an entry between two objects (status ok or too_deep) against
+/// the brute-force winding number (every face, no hierarchy): on each side, the listed
+/// vertices are exactly those reached from the vertices of the entry's intersecting triangles
+/// (`pairs`: the frame's intersecting pairs) through vertices inside the other object. Returns
+/// how many vertices were listed.
+inline size_t expect_inside_is_walk_closure(const Frame& frame, const PenetrationDepth& e,
+                                            const std::vector<IntersectingPair>& pairs) {
+  size_t listed_count = 0;
+  for (int side = 0; side < 2; ++side) {
+    const Object& own = frame.objects[static_cast<size_t>(e.objects[static_cast<size_t>(side)])];
+    const Object& other = frame.objects[static_cast<size_t>(e.objects[static_cast<size_t>(1 - side)])];
+    auto inside = [&](Index v) {
+      bool on = false;
+      const int w = winding_number_brute_force(own.positions[static_cast<size_t>(v)], other, on);
+      return !on && w != 0;
+    };
+    const auto& list = e.inside_vertices[static_cast<size_t>(side)];
+    auto listed = [&](Index v) { return std::binary_search(list.begin(), list.end(), v); };
+    for (Index v : list) EXPECT_TRUE(inside(v)) << "side " << side << " vertex " << v;
+    for (const IntersectingPair& p : pairs) {  // the walk's seeds
+      if (p.object_a != e.objects[0] || p.object_b != e.objects[1]) continue;
+      for (Index v : own.topology->faces[static_cast<size_t>(side == 0 ? p.tri_a : p.tri_b)])
+        EXPECT_EQ(listed(v), inside(v)) << "side " << side << " seed vertex " << v;
+    }
+    const Adjacency& adj = adjacency(*own.topology);
+    for (Index v : list)  // closed under inside neighbours
+      for (Index t : adj.vertex_triangles(v))
+        for (Index u : own.topology->faces[static_cast<size_t>(t)])
+          if (!listed(u)) {
+            EXPECT_FALSE(inside(u)) << "side " << side << " neighbour " << u << " of " << v;
+          }
+    listed_count += list.size();
+  }
+  return listed_count;
+}
+
+/// Two results of the same frame are the same, every field (NaN equal to NaN).
+inline void expect_same_pd(const std::vector<PenetrationDepth>& a, const std::vector<PenetrationDepth>& b,
+                           const std::string& what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  auto same = [](double x, double y) { return x == y || (std::isnan(x) && std::isnan(y)); };
+  auto same_vec = [&](const Vec3& x, const Vec3& y) { return same(x[0], y[0]) && same(x[1], y[1]) && same(x[2], y[2]); };
+  for (size_t k = 0; k < a.size(); ++k) {
+    SCOPED_TRACE(what + ", entry " + std::to_string(k));
+    EXPECT_EQ(a[k].objects, b[k].objects);
+    EXPECT_EQ(a[k].status, b[k].status);
+    EXPECT_TRUE(same(a[k].depth, b[k].depth)) << a[k].depth << " vs " << b[k].depth;
+    EXPECT_TRUE(same_vec(a[k].direction, b[k].direction));
+    EXPECT_EQ(a[k].deepest_object, b[k].deepest_object);
+    EXPECT_EQ(a[k].deepest_vertex, b[k].deepest_vertex);
+    EXPECT_TRUE(same_vec(a[k].deepest_point, b[k].deepest_point));
+    EXPECT_TRUE(same_vec(a[k].nearest_point, b[k].nearest_point));
+    EXPECT_EQ(a[k].inside_vertices, b[k].inside_vertices);
+    EXPECT_EQ(a[k].overlapping_triangles, b[k].overlapping_triangles);
+  }
+}
+
+}  // namespace vproxq::test
