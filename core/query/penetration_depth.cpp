@@ -589,12 +589,16 @@ std::vector<Index> overlapping_triangles(const Object& o, const std::vector<Inde
 /// all 0: T is then the overlapping face normal along which the overlap is narrowest (for a
 /// convex overlap, a facet normal is a candidate minimal translation direction), times
 /// `sign[side]` so that it points the way objects[0]'s side must move; Shallow when every
-/// overlapping face is degenerate.
+/// overlapping face is degenerate. The same where the deepest vertex's nearest point is
+/// computed on the vertex itself (its distance, though not 0, is below the rounding of the
+/// coordinates, so every inside vertex lies within rounding of the other surface): its
+/// vector gives no direction.
 PenetrationDepth finish_depth(PenetrationDepth& pd, double best, const std::vector<Vec3>& points,
                               const std::array<const Object*, 2>& owner,
                               const std::array<double, 2>& sign) {
-  if (best > 0) {
-    pd.direction /= pd.direction.norm();
+  const double length = pd.direction.norm();
+  if (best > 0 && length > 0) {
+    pd.direction /= length;
     pd.depth = width(points, pd.direction);
     pd.status = PdStatus::Ok;
     return pd;
