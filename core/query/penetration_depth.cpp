@@ -249,6 +249,8 @@ struct SelfContext {
   std::vector<Index> component;  ///< per vertex: the component's root
   std::vector<Index> top;        ///< per root: the lexicographically largest vertex
   std::vector<int> reference;    ///< per root: its w_out; kUnset, or kUndecided
+  /// Per root: whether an intersecting pair of the object has both triangles in the component.
+  std::vector<char> crosses_itself;
   static constexpr int kUnset = 1 << 30, kUndecided = kUnset + 1;
 
   explicit SelfContext(const ObjectView& v) : view(&v) {
@@ -272,6 +274,21 @@ struct SelfContext {
       component[k] = r;
       Index& t = top[static_cast<size_t>(r)];
       if (t == kNoIndex || larger(static_cast<Index>(k), t)) t = static_cast<Index>(k);
+    }
+  }
+
+  /// The component's root of triangle t.
+  Index component_of_triangle(Index t) const {
+    return component[static_cast<size_t>(view->object->topology->faces[static_cast<size_t>(t)][0])];
+  }
+
+  /// Marks the components in which the object's intersecting pairs [first, last) cross.
+  void mark_crossings(std::vector<IntersectingPair>::const_iterator first,
+                      std::vector<IntersectingPair>::const_iterator last) {
+    crosses_itself.assign(component.size(), 0);
+    for (auto it = first; it != last; ++it) {
+      const Index r = component_of_triangle(it->tri_a);
+      if (r == component_of_triangle(it->tri_b)) crosses_itself[static_cast<size_t>(r)] = 1;
     }
   }
 
@@ -648,14 +665,17 @@ PenetrationDepth finish_depth(PenetrationDepth& pd, double best, const std::vect
 //    contact is undecided (status self_intersection).
 //  - T: for each v in C, its nearest point on the object outside R(C), i.e. on the sheet(s)
 //    across the curve; the pair of maximal distance gives T, the translation of the deepest
-//    vertex's sheet that brings it out. Leaving in triangles of the vertex's own side
-//    beyond the curve is harmless when they lie outside the other sheet: the segment from v
-//    (inside it) to such a point crosses the other sheet first, at a nearer point.
+//    vertex's sheet that brings it out. Where C's mesh component crosses no part of itself,
+//    the whole component is excluded with R(C): it is one sheet. Leaving in triangles of the
+//    vertex's own side beyond the curve is harmless when they lie outside the other sheet:
+//    the segment from v (inside it) to such a point crosses the other sheet first, at a
+//    nearer point; not so for a piece inside the other sheet that R(C) does not reach.
 //  - depth: the width along T of all inside vertices of the contact and of the vertices of
 //    its intersection segments, as between objects.
-// For two objects merged into one (with or without a bridge elsewhere) this is the
-// inter-object computation: the inside vertices are the same, R(C) is the vertex's own
-// object's part inside the other, and the nearest point lies on the other object.
+// For two objects merged into one without a bridge this is the inter-object computation:
+// the inside vertices are the same, and the nearest point lies on the other object (its
+// component). With a bridge elsewhere, R(C) is the vertex's own object's part near the
+// contact.
 // ---------------------------------------------------------------------------------------
 
 /// PD of one self-intersection contact of the object of `view` (pairs [first, last) of it).
@@ -765,9 +785,18 @@ PenetrationDepth self_contact_depth(SelfContext& ctx, Index object, const std::v
     std::sort(touching[c].begin(), touching[c].end());
     touching[c].erase(std::unique(touching[c].begin(), touching[c].end()), touching[c].end());
     std::sort(region_hits[c].begin(), region_hits[c].end());
+    // A mesh component that crosses no part of itself is one sheet: all of it is C's own
+    // sheet, and the other sheets are other components (R(C) alone can leave out pieces of
+    // it that lie inside the other sheet, nearer than its surface: a tetrahedron's corner
+    // pushed through a face of a box, next to the box's corner inside the tetrahedron).
+    const Index own_component = ctx.component[static_cast<size_t>(walk.components[c].front())];
+    const bool whole_component = !ctx.crosses_itself[static_cast<size_t>(own_component)];
+    auto own_sheet = [&](Index t) {
+      return in_region(t) || (whole_component && ctx.component_of_triangle(t) == own_component);
+    };
     for (Index v : walk.components[c]) {
       const Vec3& p = o.positions[static_cast<size_t>(v)];
-      const Nearest near = nearest_point(p, view, slack, in_region);
+      const Nearest near = nearest_point(p, view, slack, own_sheet);
       if (near.triangle == kNoIndex) {  // the own sheet is the whole object
         undecided = true;
         break;
@@ -872,6 +901,7 @@ PenetrationDepth self_depth(const ObjectView& view, PdStatus surface,
   std::stable_sort(keyed.begin(), keyed.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   SelfContext ctx(view);
+  ctx.mark_crossings(first, last);
   std::vector<int> stamp(n, -1);
   int next_stamp = 0;
   PenetrationDepth chosen;
