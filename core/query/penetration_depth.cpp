@@ -564,11 +564,14 @@ struct Deepest {
   LazyExact exact;
   bool found = false;
 
-  bool deeper(const Vec3& p, const Nearest& n, const Object& other, double slack) {
+  /// Whether p, whose nearest point is n, is deeper than the deepest so far (exactly); with
+  /// `on_tie`, also where they are exactly as deep.
+  bool deeper(const Vec3& p, const Nearest& n, const Object& other, double slack, bool on_tie = false) {
     if (n.triangle == kNoIndex) return false;
     if (!found) return true;
     LazyExact candidate(p, other.triangle(n.triangle));
-    return compare_distances(n.distance, candidate, nearest.distance, exact, slack) > 0;
+    const int order = compare_distances(n.distance, candidate, nearest.distance, exact, slack);
+    return order > 0 || (on_tie && order == 0);
   }
   void take(const Vec3& p, const Nearest& n, const Object& other) {
     nearest = n;
@@ -801,7 +804,9 @@ PenetrationDepth self_contact_depth(SelfContext& ctx, Index object, const std::v
         undecided = true;
         break;
       }
-      if (deepest.deeper(p, near, o, slack)) {
+      // Ties: the smallest vertex id (the floods come in the order of their first seed
+      // vertex, each ascending, so a later flood can hold a smaller id).
+      if (deepest.deeper(p, near, o, slack, v < pd.deepest_vertex)) {
         deepest.take(p, near, o);
         deepest_component = c;
         pd.deepest_object = object;
