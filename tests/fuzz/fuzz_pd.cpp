@@ -19,6 +19,7 @@
 #include "core/query/penetration_depth.hpp"
 #include "fuzz_support.hpp"
 #include "support/pd_checks.hpp"
+#include "support/self_meshes.hpp"
 #include "trap_on_test_failure.hpp"
 
 #include <gtest/gtest.h>
@@ -81,13 +82,7 @@ Object base_shape(int kind) {
     const Vec3 n = (p[static_cast<size_t>(face[1])] - a).cross(p[static_cast<size_t>(face[2])] - a);
     if (n.dot(a - centroid) < 0) std::swap(face[1], face[2]);
   }
-  Object o;
-  auto topo = std::make_shared<Topology>();
-  topo->num_vertices = static_cast<Index>(p.size());
-  topo->faces = f;
-  o.topology = topo;
-  o.positions = p;
-  return o;
+  return test::make_object(p, f, "");
 }
 
 double jitter(Reader& in) {
@@ -225,15 +220,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return std::array<Face, 2>{a.topology->faces[static_cast<size_t>(p.tri_a)], b.topology->faces[static_cast<size_t>(p.tri_b)]};
   };
   if (count_contacts(pairs, faces_of) != 1) return 0;
-  Object merged = a;
-  auto topo = std::make_shared<Topology>(*a.topology);
   const Index nv = a.num_vertices(), nt = a.num_triangles();
-  for (const Face& f : b.topology->faces) topo->faces.push_back({f[0] + nv, f[1] + nv, f[2] + nv});
-  topo->num_vertices = nv + b.num_vertices();
-  merged.topology = topo;
-  merged.positions.insert(merged.positions.end(), b.positions.begin(), b.positions.end());
-  merged.name = "ab";
-  const Frame one = frame_of({merged});
+  std::vector<Vec3> positions = a.positions;
+  positions.insert(positions.end(), b.positions.begin(), b.positions.end());
+  std::vector<Face> faces = a.topology->faces;
+  for (const Face& f : b.topology->faces) faces.push_back({f[0] + nv, f[1] + nv, f[2] + nv});
+  const Frame one = frame_of({test::make_object(positions, faces, "ab")});
   const std::vector<IntersectingPair> self_pairs = intersecting_pairs_brute_force(one).pairs;
   std::vector<IntersectingPair> shifted;
   for (const IntersectingPair& p : pairs) shifted.push_back({0, p.tri_a, 0, p.tri_b + nt});
