@@ -789,9 +789,9 @@ PenetrationDepth self_contact_depth(SelfContext& ctx, Index object, const std::v
     touching[c].erase(std::unique(touching[c].begin(), touching[c].end()), touching[c].end());
     std::sort(region_hits[c].begin(), region_hits[c].end());
     // A mesh component that crosses no part of itself is one sheet: all of it is C's own
-    // sheet, and the other sheets are other components (R(C) alone can leave out pieces of
-    // it that lie inside the other sheet, nearer than its surface: a tetrahedron's corner
-    // pushed through a face of a box, next to the box's corner inside the tetrahedron).
+    // sheet, and the other sheets are other components (R(C) alone can leave out a piece of
+    // it that lies inside the other sheet, cut off by the curve and nearer to v than the other
+    // sheet's surface: a jittered box's vertex inside a tetrahedron, tests/fuzz/seeds/pd).
     const Index own_component = ctx.component[static_cast<size_t>(walk.components[c].front())];
     const bool whole_component = !ctx.crosses_itself[static_cast<size_t>(own_component)];
     auto own_sheet = [&](Index t) {
