@@ -833,7 +833,13 @@ PenetrationDepth self_contact_depth(SelfContext& ctx, Index object, const std::v
     const size_t side = c == deepest_component ? 0 : 1;
     verts[side].insert(verts[side].end(), walk.components[c].begin(), walk.components[c].end());
     if (side == 0) {
-      std::set_union(touching[c].begin(), touching[c].end(), region_hits[c].begin(), region_hits[c].end(),
+      // R(C)'s intersecting triangles: the curve's way across an edge can also reach a
+      // triangle that intersects nothing listed (it meets the other sheet only where it shares
+      // a vertex with it, e.g. along a box edge a vertex was moved onto), which is no
+      // overlapping triangle (README, step 2).
+      std::vector<Index> bounding;
+      std::copy_if(region_hits[c].begin(), region_hits[c].end(), std::back_inserter(bounding), is_hit);
+      std::set_union(touching[c].begin(), touching[c].end(), bounding.begin(), bounding.end(),
                      std::back_inserter(tris[0]));
     } else {
       tris[1].insert(tris[1].end(), touching[c].begin(), touching[c].end());

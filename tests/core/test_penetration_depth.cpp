@@ -809,6 +809,65 @@ TEST(PenetrationDepthSelf, SheetRunningOnAcrossAnEdgeIsNotTheTarget) {
   EXPECT_LE(std::abs(std::abs(self.direction.y()) - 1), 1e-12) << self.direction.transpose();
 }
 
+TEST(PenetrationDepthSelf, OverlappingTrianglesIntersectOrTouchAnInsideVertex) {
+  // An independent oracle's case, as its generator wrote it (the vertex order decides which
+  // flood holds the deepest vertex): the unit box (4 x 4 x 2 cells) with its top's interior
+  // vertices pushed down to z = -1/4 through the bottom, and the top rim's vertex (0.25, 0, 1)
+  // moved onto the box edge x = y = 0 at z = 0.75. Triangle 57, (0, 0, 0.5), (0.25, 0, 0.5),
+  // (0, 0, 0.75), then meets face 19 of the other sheet along that edge, where the two share a
+  // vertex (no intersecting pair), and was listed as overlapping; README step 2 lists only the
+  // intersecting triangles and those touching an inside vertex.
+  const std::vector<int> quarters = {  // x, y, z of each vertex, times 4
+      4, 0, 0, 4, 0, 2, 4, 0, 4, 4, 1, 0, 4, 1, 2, 4, 1, 4, 4, 2, 0, 4, 2, 2, 4, 2, 4, 4, 3, 0,
+      4, 3, 2, 4, 3, 4, 4, 4, 0, 4, 4, 2, 4, 4, 4, 0, 0, 0, 0, 0, 2, 0, 0, 4, 0, 1, 0, 0, 1, 2,
+      0, 1, 4, 0, 2, 0, 0, 2, 2, 0, 2, 4, 0, 3, 0, 0, 3, 2, 0, 3, 4, 0, 4, 0, 0, 4, 2, 0, 4, 4,
+      1, 4, 0, 2, 4, 0, 3, 4, 0, 1, 4, 2, 2, 4, 2, 3, 4, 2, 1, 4, 4, 2, 4, 4, 3, 4, 4, 1, 0, 0,
+      2, 0, 0, 3, 0, 0, 1, 0, 2, 2, 0, 2, 3, 0, 2, 0, 0, 3, 2, 0, 4, 3, 0, 4, 1, 1, -1, 1, 2, -1,
+      1, 3, -1, 2, 1, -1, 2, 2, -1, 2, 3, -1, 3, 1, -1, 3, 2, -1, 3, 3, -1, 1, 1, 0, 1, 2, 0, 1, 3, 0,
+      2, 1, 0, 2, 2, 0, 2, 3, 0, 3, 1, 0, 3, 2, 0, 3, 3, 0,
+  };
+  const std::vector<Index> corners = {  // three per face, 0-based
+      0, 3, 4, 0, 4, 1, 1, 4, 5, 1, 5, 2, 3, 6, 7, 3, 7, 4, 4, 7, 8, 4, 8, 5, 6, 9, 10, 6, 10, 7, 7, 10,
+      11, 7, 11, 8, 9, 12, 13, 9, 13, 10, 10, 13, 14, 10, 14, 11, 15, 19, 18, 15, 16, 19, 16, 20, 19, 16, 17, 20, 18, 22, 21, 18,
+      19, 22, 19, 23, 22, 19, 20, 23, 21, 25, 24, 21, 22, 25, 22, 26, 25, 22, 23, 26, 24, 28, 27, 24, 25, 28, 25, 29, 28, 25, 26, 29,
+      27, 28, 33, 27, 33, 30, 30, 33, 34, 30, 34, 31, 31, 34, 35, 31, 35, 32, 32, 35, 13, 32, 13, 12, 28, 29, 36, 28, 36, 33, 33, 36,
+      37, 33, 37, 34, 34, 37, 38, 34, 38, 35, 35, 38, 14, 35, 14, 13, 15, 42, 16, 15, 39, 42, 39, 43, 42, 39, 40, 43, 40, 44, 43, 40,
+      41, 44, 41, 1, 44, 41, 0, 1, 16, 45, 17, 16, 42, 45, 42, 46, 45, 42, 43, 46, 43, 47, 46, 43, 44, 47, 44, 2, 47, 44, 1, 2,
+      17, 45, 48, 17, 48, 20, 20, 48, 49, 20, 49, 23, 23, 49, 50, 23, 50, 26, 26, 50, 36, 26, 36, 29, 45, 46, 51, 45, 51, 48, 48, 51,
+      52, 48, 52, 49, 49, 52, 53, 49, 53, 50, 50, 53, 37, 50, 37, 36, 46, 47, 54, 46, 54, 51, 51, 54, 55, 51, 55, 52, 52, 55, 56, 52,
+      56, 53, 53, 56, 38, 53, 38, 37, 47, 2, 5, 47, 5, 54, 54, 5, 8, 54, 8, 55, 55, 8, 11, 55, 11, 56, 56, 11, 14, 56, 14, 38,
+      15, 57, 39, 15, 18, 57, 18, 58, 57, 18, 21, 58, 21, 59, 58, 21, 24, 59, 24, 30, 59, 24, 27, 30, 39, 60, 40, 39, 57, 60, 57, 61,
+      60, 57, 58, 61, 58, 62, 61, 58, 59, 62, 59, 31, 62, 59, 30, 31, 40, 63, 41, 40, 60, 63, 60, 64, 63, 60, 61, 64, 61, 65, 64, 61,
+      62, 65, 62, 32, 65, 62, 31, 32, 41, 3, 0, 41, 63, 3, 63, 6, 3, 63, 64, 6, 64, 9, 6, 64, 65, 9, 65, 12, 9, 65, 32, 12,
+  };
+  std::vector<Vec3> positions;
+  for (size_t k = 0; k < quarters.size(); k += 3)
+    positions.emplace_back(quarters[k] / 4.0, quarters[k + 1] / 4.0, quarters[k + 2] / 4.0);
+  std::vector<Face> faces;
+  for (size_t k = 0; k < corners.size(); k += 3) faces.push_back({corners[k], corners[k + 1], corners[k + 2]});
+  const Object o = literal_object(positions, faces, "dented");
+  ASSERT_TRUE(closed_and_oriented(o));
+  const Frame frame = frame_of({o});
+  const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
+  const auto pairs = intersecting_pairs(frame, boxes, {2, nullptr, true}).pairs;
+  const auto pd = penetration_depth(frame, boxes, pairs, {2}).pairs;
+  ASSERT_EQ(pd.size(), 1u);
+  ASSERT_EQ(pd[0].status, PdStatus::Ok) << pd_status_name(pd[0].status);
+  EXPECT_EQ(pd[0].depth, 1.0);
+  std::vector<Index> inside = pd[0].inside_vertices[0];
+  inside.insert(inside.end(), pd[0].inside_vertices[1].begin(), pd[0].inside_vertices[1].end());
+  std::sort(inside.begin(), inside.end());
+  EXPECT_EQ(inside.size(), 18u);
+  for (int side = 0; side < 2; ++side)
+    for (Index t : pd[0].overlapping_triangles[static_cast<size_t>(side)]) {
+      bool listed = false;
+      for (const IntersectingPair& p : pairs) listed = listed || p.tri_a == t || p.tri_b == t;
+      for (Index v : o.topology->faces[static_cast<size_t>(t)])
+        listed = listed || std::binary_search(inside.begin(), inside.end(), v);
+      EXPECT_TRUE(listed) << "triangle " << t;
+    }
+}
+
 TEST(PenetrationDepthSelf, UndefinedCasesGetAStatus) {
   const BoxPair bp = make_box_pair(0.15);
   {  // one face of A removed: open
