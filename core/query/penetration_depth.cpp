@@ -172,10 +172,16 @@ int ray_crossing_star(const StarPoint& q, const Triangle& t, bool& coplanar) {
 enum class VertexSide : std::uint8_t {
   Decided,       ///< w_out computed
   OnOtherSheet,  ///< v lies on a face that does not contain it (another sheet passes through v)
-  Undecided,     ///< every face of the star is degenerate, or another face covers it coplanarly
+  FoldedStar,    ///< w_out depends on the star face it is read from: v's star folds through itself
+  Undecided,     ///< every face of the star is degenerate, or another face covers one coplanarly
 };
 
-/// w_out of vertex v of `o` (see above), counting only the faces t with keep(t).
+/// w_out of vertex v of `o` (see above), counting only the faces t with keep(t). It is read
+/// from every non-degenerate face of v's star: where the star is an embedded disc near v, its
+/// faces' outward sides are one region and agree. Where two of v's faces cross each other (the
+/// star folds through itself; such faces share v, so the pair is not an intersecting pair), v
+/// is an end of that crossing curve and the outward sides of its faces can lie in regions of
+/// different winding: like a vertex on another face, v then lies on the curve (FoldedStar).
 template <typename Keep>
 VertexSide outward_winding(const ObjectView& view, Index v, const Keep& keep, int& w_out) {
   const Object& o = *view.object;
@@ -194,32 +200,38 @@ VertexSide outward_winding(const ObjectView& view, Index v, const Keep& keep, in
     if (!on && !has_v(t) && keep(t)) on = segment_triangle_intersection(p, p, o.triangle(t)).intersecting;
   });
   if (on) return VertexSide::OnOtherSheet;
-  const Adjacency& adj = adjacency(*o.topology);
-  Index face = kNoIndex;
-  for (Index t : adj.vertex_triangles(v))
-    if (!triangle_is_degenerate(o.triangle(t))) {
-      face = t;
-      break;
-    }
-  if (face == kNoIndex) return VertexSide::Undecided;
-  const Face& f = o.topology->faces[static_cast<size_t>(face)];
-  const int k = f[0] == v ? 0 : f[1] == v ? 1 : 2;
-  const StarPoint q{p, o.positions[static_cast<size_t>(f[static_cast<size_t>((k + 1) % 3)])],
-                    o.positions[static_cast<size_t>(f[static_cast<size_t>((k + 2) % 3)])]};
+  // The faces the ray from v can cross (the faces near the symbolic point contain v).
   AABB ray;
   ray.lo = p;
   ray.hi = Vec3(kInfinity, p.y(), p.z());
-  int sum = 0;
-  bool coplanar = false;
+  std::vector<Index> candidates;
   view.bvh->query(ray, [] { return 0.0; }, [&](Index t, double) {
-    if (t != face && !coplanar && keep(t)) sum += ray_crossing_star(q, o.triangle(t), coplanar);
+    if (keep(t)) candidates.push_back(t);
   });
-  if (coplanar) return VertexSide::Undecided;
-  const Triangle tf = o.triangle(face);
-  int side = 0;
-  for (int axis = 0; axis < 3 && side == 0; ++axis) side = orient2d_projected(tf[0], tf[1], tf[2], axis);
-  w_out = side > 0 ? sum : sum - 1;
-  return VertexSide::Decided;
+  const Adjacency& adj = adjacency(*o.topology);
+  bool any = false, folded = false;
+  for (Index face : adj.vertex_triangles(v)) {
+    const Triangle tf = o.triangle(face);
+    if (triangle_is_degenerate(tf)) continue;
+    const Face& f = o.topology->faces[static_cast<size_t>(face)];
+    const int k = f[0] == v ? 0 : f[1] == v ? 1 : 2;
+    const StarPoint q{p, o.positions[static_cast<size_t>(f[static_cast<size_t>((k + 1) % 3)])],
+                      o.positions[static_cast<size_t>(f[static_cast<size_t>((k + 2) % 3)])]};
+    int sum = 0;
+    bool coplanar = false;
+    for (Index t : candidates) {
+      if (t != face) sum += ray_crossing_star(q, o.triangle(t), coplanar);
+      if (coplanar) return VertexSide::Undecided;
+    }
+    int side = 0;
+    for (int axis = 0; axis < 3 && side == 0; ++axis) side = orient2d_projected(tf[0], tf[1], tf[2], axis);
+    const int w = side > 0 ? sum : sum - 1;
+    folded = folded || (any && w != w_out);
+    w_out = w;
+    any = true;
+  }
+  if (!any) return VertexSide::Undecided;
+  return folded ? VertexSide::FoldedStar : VertexSide::Decided;
 }
 
 /// Disjoint sets over 0..n-1 (path halving; the smaller root wins, so roots are canonical).

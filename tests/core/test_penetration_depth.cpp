@@ -6,6 +6,7 @@
 #include "core/query/intersecting_pairs.hpp"
 #include "core/geometry/exact_distance.hpp"
 #include "core/geometry/point_triangle.hpp"
+#include "core/geometry/triangle_intersection.hpp"
 #include "core/mesh/adjacency.hpp"
 #include "core/query/penetration_depth.hpp"
 #include "support/pd_checks.hpp"
@@ -866,6 +867,88 @@ TEST(PenetrationDepthSelf, OverlappingTrianglesIntersectOrTouchAnInsideVertex) {
         listed = listed || std::binary_search(inside.begin(), inside.end(), v);
       EXPECT_TRUE(listed) << "triangle " << t;
     }
+}
+
+TEST(PenetrationDepthSelf, FoldedStarIsOnTheCurve) {
+  // An independent oracle's case (a random fold of a box with dyadic jitter, as its generator
+  // wrote it): faces 93 and 96 of vertex 59's star share only that vertex and cross each
+  // other, so the star passes through itself at 59, a vertex of the contact. Its w_out was
+  // read from its first face: 0 from five of its faces, -1 from face 96, so with face 96
+  // moved to the front of the list the entry became self_intersection instead of depth 1.133.
+  // w_out is now read from every face of the star; where they differ, the vertex lies on the
+  // curve (not inside), whatever the face order.
+  const std::vector<int> sixty_fourths = {  // x, y, z of each vertex, times 64
+      63, 0, 1, 64, 1, 17, 66, 0, 30, 64, 0, 48, 63, 2, 65, 62, 17, 2, 62, 18, 14, 62, 15, 32, 65,
+      15, 47, 62, 15, 62, 64, 33, -1, 66, 34, 18, 64, 30, 30, 62, 34, 49, 64, 32, 66, 66, 47, -2,
+      63, 50, 17, 62, 46, 33, 64, 48, 46, 63, 46, 63, 63, 63, 0, 65, 63, 17, 64, 66, 32, 62, 63, 48,
+      62, 63, 66, 1, -1, -2, -1, -2, 16, -1, 2, 31, 1, -1, 47, 2, 0, 66, -1, 18, 0, 0, 18, 18, 2,
+      14, 33, -2, 15, 47, -2, 17, 63, 0, 34, 2, 0, 34, 16, -2, 31, 30, -1, 31, 48, 0, 33, 62, 1, 47,
+      2, 2, 50, 15, 2, 46, 32, -1, 50, 46, -2, 48, 65, 1, 66, 1, -2, 65, 14, -1, 63, 34, -1, 62, 48,
+      1, 64, 65, 32, 65, 1, 31, 62, 17, 33, 62, 33, 34, 66, 47, 30, 66, 66, 33, -2, 1, 34, -2, 18,
+      33, 1, 31, 34, 2, 47, 32, -2, 63, 30, 17, -24, 34, 32, -25, 33, 49, 65, 30, 15, -2, 33, 31,
+      -2, 31, 48, 1,
+  };
+  const std::vector<Index> corners = {  // three per face, 0-based
+      0, 5, 6, 0, 6, 1, 1, 6, 7, 1, 7, 2, 2, 7, 8, 2, 8, 3, 3, 8, 9, 3, 9, 4, 5, 10, 11, 5, 11, 6,
+      6, 11, 12, 6, 12, 7, 7, 12, 13, 7, 13, 8, 8, 13, 14, 8, 14, 9, 10, 15, 16, 10, 16, 11, 11, 16,
+      17, 11, 17, 12, 12, 17, 18, 12, 18, 13, 13, 18, 19, 13, 19, 14, 15, 20, 21, 15, 21, 16, 16,
+      21, 22, 16, 22, 17, 17, 22, 23, 17, 23, 18, 18, 23, 24, 18, 24, 19, 25, 31, 30, 25, 26, 31,
+      26, 32, 31, 26, 27, 32, 27, 33, 32, 27, 28, 33, 28, 34, 33, 28, 29, 34, 30, 36, 35, 30, 31,
+      36, 31, 37, 36, 31, 32, 37, 32, 38, 37, 32, 33, 38, 33, 39, 38, 33, 34, 39, 35, 41, 40, 35,
+      36, 41, 36, 42, 41, 36, 37, 42, 37, 43, 42, 37, 38, 43, 38, 44, 43, 38, 39, 44, 40, 46, 45,
+      40, 41, 46, 41, 47, 46, 41, 42, 47, 42, 48, 47, 42, 43, 48, 43, 49, 48, 43, 44, 49, 45, 46,
+      51, 45, 51, 50, 50, 51, 21, 50, 21, 20, 46, 47, 52, 46, 52, 51, 51, 52, 22, 51, 22, 21, 47,
+      48, 53, 47, 53, 52, 52, 53, 23, 52, 23, 22, 48, 49, 54, 48, 54, 53, 53, 54, 24, 53, 24, 23,
+      25, 56, 26, 25, 55, 56, 55, 1, 56, 55, 0, 1, 26, 57, 27, 26, 56, 57, 56, 2, 57, 56, 1, 2, 27,
+      58, 28, 27, 57, 58, 57, 3, 58, 57, 2, 3, 28, 59, 29, 28, 58, 59, 58, 4, 59, 58, 3, 4, 29, 59,
+      60, 29, 60, 34, 34, 60, 61, 34, 61, 39, 39, 61, 62, 39, 62, 44, 44, 62, 54, 44, 54, 49, 59, 4,
+      9, 59, 9, 60, 60, 9, 14, 60, 14, 61, 61, 14, 19, 61, 19, 62, 62, 19, 24, 62, 24, 54, 25, 63,
+      55, 25, 30, 63, 30, 64, 63, 30, 35, 64, 35, 65, 64, 35, 40, 65, 40, 50, 65, 40, 45, 50, 55, 5,
+      0, 55, 63, 5, 63, 10, 5, 63, 64, 10, 64, 15, 10, 64, 65, 15, 65, 20, 15, 65, 50, 20,
+  };
+  std::vector<Vec3> positions;
+  for (size_t k = 0; k < sixty_fourths.size(); k += 3)
+    positions.emplace_back(sixty_fourths[k] / 64.0, sixty_fourths[k + 1] / 64.0, sixty_fourths[k + 2] / 64.0);
+  std::vector<Face> faces;
+  for (size_t k = 0; k < corners.size(); k += 3) faces.push_back({corners[k], corners[k + 1], corners[k + 2]});
+  const Object o = literal_object(positions, faces, "folded");
+  ASSERT_TRUE(closed_and_oriented(o));
+  // The fold: 93 = (28, 58, 59) and 96 = (29, 59, 60) meet away from 59 (an edge of one opposite
+  // 59 meets the other: the two triangles' intersection, a segment from 59, ends on it).
+  ASSERT_EQ(faces[93], (Face{28, 58, 59}));
+  ASSERT_EQ(faces[96], (Face{29, 59, 60}));
+  const Triangle t93 = o.triangle(93), t96 = o.triangle(96);
+  EXPECT_TRUE(segment_triangle_intersection(positions[28], positions[58], t96).intersecting ||
+              segment_triangle_intersection(positions[29], positions[60], t93).intersecting);
+  const auto reference = run_pd(frame_of({o}));
+  ASSERT_EQ(reference.size(), 1u);
+  ASSERT_EQ(reference[0].status, PdStatus::Ok) << pd_status_name(reference[0].status);
+  EXPECT_GT(reference[0].depth, 1.0);
+  for (const auto& side : reference[0].inside_vertices) EXPECT_FALSE(std::count(side.begin(), side.end(), 59));
+  // Each face of 59's star moved to the front in turn: the same entry (triangle ids mapped back).
+  for (Index front : adjacency(*o.topology).vertex_triangles(59)) {
+    SCOPED_TRACE("face " + std::to_string(front) + " first");
+    std::vector<Index> order = {front};  // order[new id] = old id
+    for (Index t = 0; t < o.num_triangles(); ++t)
+      if (t != front) order.push_back(t);
+    std::vector<Face> permuted;
+    for (Index t : order) permuted.push_back(faces[static_cast<size_t>(t)]);
+    const auto pd = run_pd(frame_of({literal_object(positions, permuted, "folded")}));
+    ASSERT_EQ(pd.size(), 1u);
+    ASSERT_EQ(pd[0].status, PdStatus::Ok) << pd_status_name(pd[0].status);
+    EXPECT_EQ(pd[0].depth, reference[0].depth);
+    EXPECT_EQ(pd[0].direction, reference[0].direction);
+    EXPECT_EQ(pd[0].inside_vertices, reference[0].inside_vertices);
+    EXPECT_EQ(pd[0].deepest_vertex, reference[0].deepest_vertex);
+    for (int side = 0; side < 2; ++side) {
+      std::vector<Index> mapped;
+      for (Index t : pd[0].overlapping_triangles[static_cast<size_t>(side)]) mapped.push_back(order[static_cast<size_t>(t)]);
+      std::sort(mapped.begin(), mapped.end());
+      std::vector<Index> expected = reference[0].overlapping_triangles[static_cast<size_t>(side)];
+      std::sort(expected.begin(), expected.end());
+      EXPECT_EQ(mapped, expected);
+    }
+  }
 }
 
 TEST(PenetrationDepthSelf, UndefinedCasesGetAStatus) {
