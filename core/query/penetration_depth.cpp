@@ -885,9 +885,10 @@ PenetrationDepth self_contact_depth(SelfContext& ctx, Index object, const std::v
   return finish_depth(pd, deepest.found ? deepest.nearest.distance : -1.0, points, {&o, &o}, {-1.0, -1.0});
 }
 
-/// The entry of a self-intersecting object: its contacts (see above), reported as the first
-/// contact that is too_deep or undecided if any (no number may hide a deeper or unknown
-/// overlap), else the contact of greatest depth.
+/// The entry of a self-intersecting object: its contacts (see above), in the order of their
+/// smallest triangle ids, reported as the first contact that is too_deep or undecided if any
+/// (no number may hide a deeper or unknown overlap), else the contact of greatest depth (the
+/// first of equally deep ones).
 PenetrationDepth self_depth(const ObjectView& view, PdStatus surface,
                             std::vector<IntersectingPair>::const_iterator first,
                             std::vector<IntersectingPair>::const_iterator last) {

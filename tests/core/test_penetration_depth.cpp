@@ -951,6 +951,38 @@ TEST(PenetrationDepthSelf, FoldedStarIsOnTheCurve) {
   }
 }
 
+TEST(PenetrationDepthSelf, EquallyDeepContactsGiveTheOneWithTheSmallestTriangle) {
+  // Two copies of one overlapping box pair, 8 apart along x, as one object: two contacts of
+  // exactly the same depth. The entry is the contact holding the smallest triangle id, in
+  // either order of the copies.
+  const Object a = make_box(Vec3::Zero(), Vec3::Ones(), 2, "a");
+  const Object b = make_box(Vec3(0.75, 0.25, 0.125), Vec3(1, 0.5, 0.75), 1, "b");
+  auto moved = [](Object o) {
+    for (Vec3& p : o.positions) p.x() += 8;
+    return o;
+  };
+  const auto near = run_pd(frame_of({a, b})), far = run_pd(frame_of({moved(a), moved(b)}));
+  ASSERT_EQ(near.size(), 1u);
+  ASSERT_EQ(far.size(), 1u);
+  ASSERT_EQ(near[0].status, PdStatus::Ok);
+  ASSERT_EQ(near[0].depth, far[0].depth);  // the tie
+  const Index pair_triangles = a.num_triangles() + b.num_triangles();
+  for (bool near_first : {true, false}) {
+    SCOPED_TRACE(near_first ? "near copy first" : "far copy first");
+    const Object m = near_first ? merge({a, b, moved(a), moved(b)}, "m") : merge({moved(a), moved(b), a, b}, "m");
+    const auto pd = run_pd(frame_of({m}));
+    ASSERT_EQ(pd.size(), 1u);
+    ASSERT_EQ(pd[0].status, PdStatus::Ok) << pd_status_name(pd[0].status);
+    EXPECT_EQ(pd[0].depth, near[0].depth);
+    for (const auto& side : pd[0].overlapping_triangles) {
+      ASSERT_FALSE(side.empty());
+      for (Index t : side) EXPECT_LT(t, pair_triangles);
+    }
+    const double x = m.positions[static_cast<size_t>(pd[0].deepest_vertex)].x();
+    EXPECT_EQ(x < 4, near_first) << x;
+  }
+}
+
 TEST(PenetrationDepthSelf, UndefinedCasesGetAStatus) {
   const BoxPair bp = make_box_pair(0.15);
   {  // one face of A removed: open
