@@ -1,20 +1,23 @@
 // Differential fuzzing of the penetration depth: each input decodes to two closed,
 // consistently oriented objects (a tetrahedron, an octahedron, or a box of 1 or 2 cells per
-// axis; outward or inward; vertices jittered on a small grid times a power of two, sometimes
-// by a third, sometimes far from the origin) placed so that they often overlap. Checked,
-// against brute forces that share no search code with penetration_depth():
+// axis; outward or inward; the 2-cell box sometimes with a well pushed into its top, through
+// its bottom at the deepest; sometimes halved; vertices jittered on a small grid times a power
+// of two, sometimes by a third, sometimes far from the origin) placed so that they often
+// overlap. Checked, against brute forces that share no search code with penetration_depth():
 //  - 1 and 2 threads give the same entries, every field;
 //  - every entry between the two objects (status ok or too_deep) lists as inside vertices
-//    exactly the walk closure of the brute-force winding number (tests/support/pd_checks.hpp);
-//    with status ok: a unit direction, a depth no narrower than the inside vertices' extent
+//    exactly the walk closure of the brute-force winding number (tests/support/pd_checks.hpp),
+//    and is too_deep exactly where a connected set of them has no outside neighbour; with
+//    status ok: a unit direction, a depth no narrower than the inside vertices' extent
 //    along it, and the deepest vertex and its nearest point of the exact max-min over every
 //    face (the README's tie rules); no deepest vertex only when no vertex is inside;
 //  - the twin (README, "Self-intersections": for two objects merged into one, the inside test
 //    is exactly the inter-object one): where neither object intersects itself and their
 //    intersecting pairs form one contact, the two merged into one object (b's ids after a's)
 //    have the same intersecting pairs, and, unless the self entry says self_intersection
-//    (the sheets' local orientation undecidable, e.g. coplanar covers), the same inside
-//    vertices, deepest vertex, depth and direction (up to its sign).
+//    (the sheets' local orientation undecidable, e.g. coplanar covers), the same status and
+//    inside vertices; for too_deep the same overlapping triangles, for ok the same deepest
+//    vertex, depth and direction (up to its sign).
 #include "core/query/intersecting_pairs.hpp"
 #include "core/query/penetration_depth.hpp"
 #include "fuzz_support.hpp"
@@ -92,10 +95,28 @@ double jitter(Reader& in) {
   return std::ldexp(b & 1 ? 1.0 : -1.0, -20);
 }
 
-Object decode_object(Reader& in, double unit, double offset, const std::array<int, 3>& salt, const std::string& name) {
+/// Changes to an object's base shape, from the byte after both objects (0 past the end of
+/// the input, so an input that ends with the objects decodes as before): the 2-cell box's top
+/// centre pushed down 1, 2, 3 or 4.5 (a well; at 4.5 through the bottom, so the box
+/// intersects itself), and the whole shape halved (small enough to sit in another's well:
+/// a too_deep case).
+struct Variant {
+  int dent = 0;  ///< 0: none, 1..4: the depths above
+  bool half = false;
+};
+
+Object decode_object(Reader& in, double unit, double offset, const std::array<int, 3>& salt, const std::string& name,
+                     const Variant& variant = {}) {
   const std::uint8_t flags = in.next();
   Object o = base_shape(flags % 4);
   o.name = name;
+  if (variant.dent > 0 && flags % 4 == 3) {
+    constexpr double kDents[] = {1, 2, 3, 4.5};
+    for (Vec3& p : o.positions)
+      if (p == Vec3(0, 0, 2)) p.z() -= kDents[variant.dent - 1];
+  }
+  if (variant.half)
+    for (Vec3& p : o.positions) p *= 0.5;
   if (flags & 4) {  // inward
     auto topo = std::make_shared<Topology>(*o.topology);
     for (Face& face : topo->faces) std::swap(face[1], face[2]);
@@ -167,8 +188,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::uint8_t scale = in.next();
   const double unit = std::ldexp(1.0, scale % 21 - 10);
   const double offset = scale >= 224 ? std::ldexp(1.0, 20) * unit * 3 : 0.0;
-  const Object a = decode_object(in, unit, offset, {8, 8, 8}, "a");
-  const Object b = decode_object(in, unit, offset, {11, 10, 9}, "b");
+  (void)decode_object(in, unit, offset, {8, 8, 8}, "a");
+  (void)decode_object(in, unit, offset, {11, 10, 9}, "b");
+  const std::uint8_t bits = in.next();
+  in = Reader{data, size};  // decode again, with the variant read after both
+  (void)in.next();
+  auto dent = [](int three_bits) { return three_bits >= 4 ? three_bits - 3 : 0; };
+  const Object a = decode_object(in, unit, offset, {8, 8, 8}, "a", {dent(bits & 7), (bits & 64) != 0});
+  const Object b = decode_object(in, unit, offset, {11, 10, 9}, "b", {dent(bits >> 3 & 7), (bits & 128) != 0});
   const Frame frame = frame_of({a, b});
   const std::vector<IntersectingPair> pairs = intersecting_pairs_brute_force(frame).pairs;
 
@@ -185,6 +212,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     inter = &e;
     if (e.status != PdStatus::Ok && e.status != PdStatus::TooDeep) continue;
     (void)test::expect_inside_is_walk_closure(frame, e, pairs);
+    EXPECT_EQ(e.status == PdStatus::TooDeep, test::has_swallowed_set(frame, e)) << pd_status_name(e.status);
     if (e.status != PdStatus::Ok) continue;
     EXPECT_TRUE(std::isfinite(e.depth) && e.depth >= 0) << e.depth;
     EXPECT_NEAR(e.direction.norm(), 1.0, 1e-12);
@@ -213,7 +241,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
 
   // The twin: a and b as one object of two components.
-  if (!inter || inter->status != PdStatus::Ok) return 0;
+  if (!inter || (inter->status != PdStatus::Ok && inter->status != PdStatus::TooDeep)) return 0;
   for (const IntersectingPair& p : pairs)
     if (p.object_a == p.object_b) return 0;  // an object intersects itself
   const auto faces_of = [&](const IntersectingPair& p) {
@@ -235,10 +263,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   EXPECT_EQ(self.size(), 1u);
   if (self.size() != 1 || self[0].status == PdStatus::SelfIntersection) return 0;
   const PenetrationDepth& s = self[0];
-  EXPECT_EQ(s.status, PdStatus::Ok) << pd_status_name(s.status);
-  if (s.status != PdStatus::Ok) return 0;
+  EXPECT_EQ(s.status, inter->status) << pd_status_name(s.status) << " vs " << pd_status_name(inter->status);
   EXPECT_EQ(sorted_union(s.inside_vertices[0], s.inside_vertices[1], 0),
             sorted_union(inter->inside_vertices[0], inter->inside_vertices[1], nv));
+  if (inter->status == PdStatus::TooDeep) {  // the walk's vertices and step 2's triangles, as one list
+    EXPECT_EQ(sorted_union(s.overlapping_triangles[0], s.overlapping_triangles[1], 0),
+              sorted_union(inter->overlapping_triangles[0], inter->overlapping_triangles[1], nt));
+  }
+  if (s.status != PdStatus::Ok || inter->status != PdStatus::Ok) return 0;
   const Index twin_vertex = inter->deepest_vertex == kNoIndex ? kNoIndex
                             : inter->deepest_object == 0   ? inter->deepest_vertex
                                                            : inter->deepest_vertex + nv;

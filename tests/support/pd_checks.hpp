@@ -118,6 +118,40 @@ inline size_t expect_inside_is_walk_closure(const Frame& frame, const Penetratio
   return listed_count;
 }
 
+/// Whether some connected set of an entry's listed inside vertices (on either side, connected
+/// through shared triangles) has no neighbour outside the list: the README's too_deep. With the
+/// list the walk closure (expect_inside_is_walk_closure), a neighbour not listed is outside.
+inline bool has_swallowed_set(const Frame& frame, const PenetrationDepth& e) {
+  for (int side = 0; side < 2; ++side) {
+    const Object& own = frame.objects[static_cast<size_t>(e.objects[static_cast<size_t>(side)])];
+    const auto& list = e.inside_vertices[static_cast<size_t>(side)];
+    auto listed = [&](Index v) { return std::binary_search(list.begin(), list.end(), v); };
+    const Adjacency& adj = adjacency(*own.topology);
+    std::vector<char> seen(static_cast<size_t>(own.num_vertices()), 0);
+    for (Index start : list) {
+      if (seen[static_cast<size_t>(start)]) continue;
+      bool meets_outside = false;
+      std::vector<Index> stack = {start};
+      seen[static_cast<size_t>(start)] = 1;
+      while (!stack.empty()) {
+        const Index v = stack.back();
+        stack.pop_back();
+        for (Index t : adj.vertex_triangles(v))
+          for (Index u : own.topology->faces[static_cast<size_t>(t)]) {
+            if (!listed(u)) {
+              meets_outside = true;
+            } else if (!seen[static_cast<size_t>(u)]) {
+              seen[static_cast<size_t>(u)] = 1;
+              stack.push_back(u);
+            }
+          }
+      }
+      if (!meets_outside) return true;
+    }
+  }
+  return false;
+}
+
 /// Two results of the same frame are the same, every field (NaN equal to NaN).
 inline void expect_same_pd(const std::vector<PenetrationDepth>& a, const std::vector<PenetrationDepth>& b,
                            const std::string& what) {
