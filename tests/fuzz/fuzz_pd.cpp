@@ -12,7 +12,9 @@
 //    along it, and the deepest vertex and its nearest point of the exact max-min over every
 //    face (the README's tie rules); no deepest vertex only when no vertex is inside;
 //  - the twin (README, "Self-intersections": for two objects merged into one, the inside test
-//    is exactly the inter-object one): where neither object intersects itself and their
+//    is exactly the inter-object one at every vertex whose star does not pass through itself;
+//    such a vertex is not exempted here, so a jittered shape with one inside would show as a
+//    difference): where neither object intersects itself and their
 //    intersecting pairs form one contact, the two merged into one object (b's ids after a's)
 //    have the same intersecting pairs, and, unless the self entry says self_intersection
 //    (the sheets' local orientation undecidable, e.g. coplanar covers), the same status and
