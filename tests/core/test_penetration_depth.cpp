@@ -810,6 +810,18 @@ TEST(PenetrationDepthSelf, SheetRunningOnAcrossAnEdgeIsNotTheTarget) {
   EXPECT_LE(std::abs(std::abs(self.direction.y()) - 1), 1e-12) << self.direction.transpose();
 }
 
+/// An object from integer coordinates (x, y, z of each vertex) divided by `denominator`, and
+/// three 0-based corners per face, as an oracle's generator wrote them.
+Object scaled_literal(const std::vector<int>& coordinates, double denominator, const std::vector<Index>& corners,
+                      const std::string& name) {
+  std::vector<Vec3> positions;
+  for (size_t k = 0; k < coordinates.size(); k += 3)
+    positions.emplace_back(coordinates[k] / denominator, coordinates[k + 1] / denominator, coordinates[k + 2] / denominator);
+  std::vector<Face> faces;
+  for (size_t k = 0; k < corners.size(); k += 3) faces.push_back({corners[k], corners[k + 1], corners[k + 2]});
+  return literal_object(positions, faces, name);
+}
+
 TEST(PenetrationDepthSelf, OverlappingTrianglesIntersectOrTouchAnInsideVertex) {
   // An independent oracle's case, as its generator wrote it (the vertex order decides which
   // flood holds the deepest vertex): the unit box (4 x 4 x 2 cells) with its top's interior
@@ -841,12 +853,7 @@ TEST(PenetrationDepthSelf, OverlappingTrianglesIntersectOrTouchAnInsideVertex) {
       60, 57, 58, 61, 58, 62, 61, 58, 59, 62, 59, 31, 62, 59, 30, 31, 40, 63, 41, 40, 60, 63, 60, 64, 63, 60, 61, 64, 61, 65, 64, 61,
       62, 65, 62, 32, 65, 62, 31, 32, 41, 3, 0, 41, 63, 3, 63, 6, 3, 63, 64, 6, 64, 9, 6, 64, 65, 9, 65, 12, 9, 65, 32, 12,
   };
-  std::vector<Vec3> positions;
-  for (size_t k = 0; k < quarters.size(); k += 3)
-    positions.emplace_back(quarters[k] / 4.0, quarters[k + 1] / 4.0, quarters[k + 2] / 4.0);
-  std::vector<Face> faces;
-  for (size_t k = 0; k < corners.size(); k += 3) faces.push_back({corners[k], corners[k + 1], corners[k + 2]});
-  const Object o = literal_object(positions, faces, "dented");
+  const Object o = scaled_literal(quarters, 4, corners, "dented");
   ASSERT_TRUE(closed_and_oriented(o));
   const Frame frame = frame_of({o});
   const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
@@ -906,12 +913,9 @@ TEST(PenetrationDepthSelf, FoldedStarIsOnTheCurve) {
       55, 25, 30, 63, 30, 64, 63, 30, 35, 64, 35, 65, 64, 35, 40, 65, 40, 50, 65, 40, 45, 50, 55, 5,
       0, 55, 63, 5, 63, 10, 5, 63, 64, 10, 64, 15, 10, 64, 65, 15, 65, 20, 15, 65, 50, 20,
   };
-  std::vector<Vec3> positions;
-  for (size_t k = 0; k < sixty_fourths.size(); k += 3)
-    positions.emplace_back(sixty_fourths[k] / 64.0, sixty_fourths[k + 1] / 64.0, sixty_fourths[k + 2] / 64.0);
-  std::vector<Face> faces;
-  for (size_t k = 0; k < corners.size(); k += 3) faces.push_back({corners[k], corners[k + 1], corners[k + 2]});
-  const Object o = literal_object(positions, faces, "folded");
+  const Object o = scaled_literal(sixty_fourths, 64, corners, "folded");
+  const std::vector<Vec3>& positions = o.positions;
+  const std::vector<Face>& faces = o.topology->faces;
   ASSERT_TRUE(closed_and_oriented(o));
   // The fold: 93 = (28, 58, 59) and 96 = (29, 59, 60) meet away from 59 (an edge of one opposite
   // 59 meets the other: the two triangles' intersection, a segment from 59, ends on it).
