@@ -176,7 +176,49 @@ enum class VertexSide : std::uint8_t {
   Undecided,     ///< every face of the star is degenerate, or another face covers one coplanarly
 };
 
-/// w_out of vertex v of `o` (see above), counting only the faces t with keep(t). It is read
+/// v's two other corners in face f, in f's cyclic order from v.
+std::array<Index, 2> corners_after(const Face& f, Index v) {
+  const int k = f[0] == v ? 0 : f[1] == v ? 1 : 2;
+  return {f[static_cast<size_t>((k + 1) % 3)], f[static_cast<size_t>((k + 2) % 3)]};
+}
+
+/// Whether a face of v's star is covered coplanarly next to v by another face of the star
+/// (the star folded flat): the symbolic point v + eps (n1 - v) + eps^2 (n2 - v) inside f =
+/// (v, n1, n2) lies in the closed corner of g = (v, m1, m2) at v, g in f's plane. Decided in
+/// the projection that keeps f's area, with exact orientations: the point is left of v->m1 and
+/// right of v->m2 (as g's own orientation) when the first nonzero of each test's value at n1,
+/// then at n2, has g's sign. (A face not containing v that covers f next to v contains v: such
+/// a vertex lies on another sheet, tested before.)
+bool star_is_covered(const Object& o, Index v, IndexSpan star) {
+  const Vec3& p = o.positions[static_cast<size_t>(v)];
+  for (Index f : star) {
+    const Triangle tf = o.triangle(f);
+    if (triangle_is_degenerate(tf)) continue;
+    const auto [a1, a2] = corners_after(o.topology->faces[static_cast<size_t>(f)], v);
+    const Vec3& n1 = o.positions[static_cast<size_t>(a1)];
+    const Vec3& n2 = o.positions[static_cast<size_t>(a2)];
+    int axis = 0;
+    while (orient2d_projected(p, n1, n2, axis) == 0) ++axis;  // f has an area: some axis keeps it
+    for (Index g : star) {
+      if (g == f) continue;
+      const Triangle tg = o.triangle(g);
+      if (triangle_is_degenerate(tg) || orient3d(tg[0], tg[1], tg[2], n1) != 0 || orient3d(tg[0], tg[1], tg[2], n2) != 0)
+        continue;
+      const auto [b1, b2] = corners_after(o.topology->faces[static_cast<size_t>(g)], v);
+      const Vec3& m1 = o.positions[static_cast<size_t>(b1)];
+      const Vec3& m2 = o.positions[static_cast<size_t>(b2)];
+      const int sg = orient2d_projected(p, m1, m2, axis);
+      int left_of_m1 = orient2d_projected(p, m1, n1, axis);  // orient(v, m1, q)
+      if (left_of_m1 == 0) left_of_m1 = orient2d_projected(p, m1, n2, axis);
+      int right_of_m2 = orient2d_projected(p, n1, m2, axis);  // orient(v, q, m2)
+      if (right_of_m2 == 0) right_of_m2 = orient2d_projected(p, n2, m2, axis);
+      if (sg != 0 && left_of_m1 == sg && right_of_m2 == sg) return true;
+    }
+  }
+  return false;
+}
+
+/// w_out of vertex v of `o` (see above), counting only the faces t with keep(t). It is read/// w_out of vertex v of `o` (see above), counting only the faces t with keep(t). It is read
 /// from every non-degenerate face of v's star: where the star is an embedded disc near v, its
 /// faces' outward sides are one region and agree. Where two of v's faces cross each other (the
 /// star folds through itself; such faces share v, so the pair is not an intersecting pair), v
@@ -200,6 +242,8 @@ VertexSide outward_winding(const ObjectView& view, Index v, const Keep& keep, in
     if (!on && !has_v(t) && keep(t)) on = segment_triangle_intersection(p, p, o.triangle(t)).intersecting;
   });
   if (on) return VertexSide::OnOtherSheet;
+  const Adjacency& adj = adjacency(*o.topology);
+  if (star_is_covered(o, v, adj.vertex_triangles(v))) return VertexSide::Undecided;
   // The faces the ray from v can cross (the faces near the symbolic point contain v).
   AABB ray;
   ray.lo = p;
@@ -208,7 +252,6 @@ VertexSide outward_winding(const ObjectView& view, Index v, const Keep& keep, in
   view.bvh->query(ray, [] { return 0.0; }, [&](Index t, double) {
     if (keep(t)) candidates.push_back(t);
   });
-  const Adjacency& adj = adjacency(*o.topology);
   bool any = false, folded = false;
   for (Index face : adj.vertex_triangles(v)) {
     const Triangle tf = o.triangle(face);

@@ -767,6 +767,24 @@ TEST(PenetrationDepthSelf, DentPushedThroughTheBottomIsAnInwardFold) {
   }
 }
 
+TEST(PenetrationDepthSelf, StarFoldedFlatAtASeedIsUndecided) {
+  // The dented box above (d = 0.7), with the bottom's centre, a vertex of the triangles the dent
+  // goes through, moved within the bottom plane to (1.5, -0.375, 0), past its ring's edge at
+  // y = 0: the star's triangles on that edge turn over and cover their neighbours in the plane
+  // z = 0 (a flat fold). Which sheet is which cannot be told there: self_intersection. The
+  // covering faces are parallel to the +x ray, which only found covers by faces it crosses.
+  Object dented = make_box(Vec3::Zero(), Vec3::Constant(3), 2, "dented");
+  for (Vec3& p : dented.positions) {
+    if (p == Vec3(1.5, 1.5, 3)) p = Vec3(1.5, 1.5, -0.7);
+    else if (p == Vec3(1.5, 1.5, 0)) p = Vec3(1.5, -0.375, 0);
+  }
+  for (const Object& o : {dented, flip_all(dented)}) {
+    const auto pd = run_pd(frame_of({o}));
+    ASSERT_EQ(pd.size(), 1u);
+    EXPECT_EQ(pd[0].status, PdStatus::SelfIntersection) << pd_status_name(pd[0].status);
+  }
+}
+
 /// PD of boxes a and b as two objects (the twin) and as one object of two components (self),
 /// both asserted to be one entry with status Ok.
 std::pair<PenetrationDepth, PenetrationDepth> twin_and_self(const Object& a, const Object& b) {
