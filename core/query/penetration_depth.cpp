@@ -137,6 +137,7 @@ struct StarPoint {
 /// Sign of orient2d_projected(u, w, q, 0) at the symbolic q (see above).
 int orient_yz_star(const Vec3& u, const Vec3& w, const StarPoint& q) {
   for (const Vec3* p : {&q.v, &q.n1, &q.n2}) {
+    if (*p == u || *p == w) continue;  // an end of the edge: exactly 0 (no exact fallback)
     const int o = orient2d_projected(u, w, *p, 0);
     if (o != 0) return o;
   }
@@ -146,6 +147,7 @@ int orient_yz_star(const Vec3& u, const Vec3& w, const StarPoint& q) {
 /// Sign of orient3d(t, q) at the symbolic q: the n . (q - t0) of ray_crossing().
 int above_star(const Triangle& t, const StarPoint& q) {
   for (const Vec3* p : {&q.v, &q.n1, &q.n2}) {
+    if (*p == t[0] || *p == t[1] || *p == t[2]) continue;  // a corner of t: exactly 0
     const int o = orient3d(t[0], t[1], t[2], *p);
     if (o != 0) return o;
   }
@@ -202,16 +204,21 @@ bool star_is_covered(const Object& o, Index v, IndexSpan star) {
     for (Index g : star) {
       if (g == f) continue;
       const Triangle tg = o.triangle(g);
-      if (triangle_is_degenerate(tg) || orient3d(tg[0], tg[1], tg[2], n1) != 0 || orient3d(tg[0], tg[1], tg[2], n2) != 0)
-        continue;
+      // Points that are corners of g, or equal to the other point of a test, give exactly 0
+      // without calling the predicate (whose filter cannot certify a 0).
+      auto on_plane = [&](const Vec3& x) {
+        return x == tg[0] || x == tg[1] || x == tg[2] || orient3d(tg[0], tg[1], tg[2], x) == 0;
+      };
+      if (triangle_is_degenerate(tg) || !on_plane(n1) || !on_plane(n2)) continue;
       const auto [b1, b2] = corners_after(o.topology->faces[static_cast<size_t>(g)], v);
       const Vec3& m1 = o.positions[static_cast<size_t>(b1)];
       const Vec3& m2 = o.positions[static_cast<size_t>(b2)];
-      const int sg = orient2d_projected(p, m1, m2, axis);
-      int left_of_m1 = orient2d_projected(p, m1, n1, axis);  // orient(v, m1, q)
-      if (left_of_m1 == 0) left_of_m1 = orient2d_projected(p, m1, n2, axis);
-      int right_of_m2 = orient2d_projected(p, n1, m2, axis);  // orient(v, q, m2)
-      if (right_of_m2 == 0) right_of_m2 = orient2d_projected(p, n2, m2, axis);
+      auto orient = [&](const Vec3& x, const Vec3& y) { return x == y ? 0 : orient2d_projected(p, x, y, axis); };
+      const int sg = orient(m1, m2);
+      int left_of_m1 = orient(m1, n1);  // orient(v, m1, q)
+      if (left_of_m1 == 0) left_of_m1 = orient(m1, n2);
+      int right_of_m2 = orient(n1, m2);  // orient(v, q, m2)
+      if (right_of_m2 == 0) right_of_m2 = orient(n2, m2);
       if (sg != 0 && left_of_m1 == sg && right_of_m2 == sg) return true;
     }
   }
