@@ -156,19 +156,15 @@ int above_star(const Triangle& t, const StarPoint& q) {
   return ny != 0 ? ny : orient2d_projected(t[0], t[1], t[2], 2);
 }
 
-/// ray_crossing() from the symbolic q; sets coplanar when q lies on t (t covers the star
-/// face f next to v: overlapping coplanar faces, undecidable).
-int ray_crossing_star(const StarPoint& q, const Triangle& t, bool& coplanar) {
+/// ray_crossing() from the symbolic q. q never lies on t: t would then contain points next
+/// to v, hence v, and either not be one of v's faces (v on another sheet) or cover f
+/// coplanarly (star_is_covered()); outward_winding() rules out both before it casts.
+int ray_crossing_star(const StarPoint& q, const Triangle& t) {
   const int s = orient2d_projected(t[0], t[1], t[2], 0);
   if (s == 0) return 0;
   for (int k = 0; k < 3; ++k)
     if (orient_yz_star(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)], q) != s) return 0;
-  const int above = above_star(t, q);
-  if (above == 0) {
-    coplanar = true;
-    return 0;
-  }
-  return above == -s ? s : 0;
+  return above_star(t, q) == -s ? s : 0;
 }
 
 enum class VertexSide : std::uint8_t {
@@ -263,16 +259,11 @@ VertexSide outward_winding(const ObjectView& view, Index v, const Keep& keep, in
   for (Index face : adj.vertex_triangles(v)) {
     const Triangle tf = o.triangle(face);
     if (triangle_is_degenerate(tf)) continue;
-    const Face& f = o.topology->faces[static_cast<size_t>(face)];
-    const int k = f[0] == v ? 0 : f[1] == v ? 1 : 2;
-    const StarPoint q{p, o.positions[static_cast<size_t>(f[static_cast<size_t>((k + 1) % 3)])],
-                      o.positions[static_cast<size_t>(f[static_cast<size_t>((k + 2) % 3)])]};
+    const auto [n1, n2] = corners_after(o.topology->faces[static_cast<size_t>(face)], v);
+    const StarPoint q{p, o.positions[static_cast<size_t>(n1)], o.positions[static_cast<size_t>(n2)]};
     int sum = 0;
-    bool coplanar = false;
-    for (Index t : candidates) {
-      if (t != face) sum += ray_crossing_star(q, o.triangle(t), coplanar);
-      if (coplanar) return VertexSide::Undecided;
-    }
+    for (Index t : candidates)
+      if (t != face) sum += ray_crossing_star(q, o.triangle(t));
     int side = 0;
     for (int axis = 0; axis < 3 && side == 0; ++axis) side = orient2d_projected(tf[0], tf[1], tf[2], axis);
     const int w = side > 0 ? sum : sum - 1;
