@@ -135,6 +135,31 @@ inline const char* pd_status_name(PdStatus s) {
   return "unknown";
 }
 
+/// Why a self-intersection entry has no number (status SelfIntersection; README, "Where it
+/// gives no number"): the first of the undecided tests that stopped its contact.
+enum class PdReason : std::uint8_t {
+  None = 0,
+  DegenerateStar = 1,      ///< a vertex whose star has no face with a normal (reason_features: v)
+  FlatFold = 2,            ///< a face of a vertex's star is covered coplanarly by another (v)
+  ReferenceVertex = 3,     ///< the component's reference vertex (given) is undecided itself
+  SheetsNotSeparated = 4,  ///< R(C) holds both triangles of an intersecting pair (given)
+  WholeObject = 5,         ///< the own sheet R(C) is the whole object: nothing across the
+                           ///< curve for the vertex given
+};
+
+/// Stable text of a PdReason (JSON "reason", README).
+inline const char* pd_reason_name(PdReason r) {
+  switch (r) {
+    case PdReason::None: return "none";
+    case PdReason::DegenerateStar: return "degenerate_star";
+    case PdReason::FlatFold: return "flat_fold";
+    case PdReason::ReferenceVertex: return "reference_vertex";
+    case PdReason::SheetsNotSeparated: return "sheets_not_separated";
+    case PdReason::WholeObject: return "whole_object";
+  }
+  return "unknown";
+}
+
 /// Local penetration depth of one intersecting object pair (paper 3.3).
 struct PenetrationDepth {
   std::array<Index, 2> objects{kNoIndex, kNoIndex};  ///< objects[0] <= objects[1]
@@ -154,6 +179,10 @@ struct PenetrationDepth {
   /// triangles of objects[k] that intersect objects[1-k] or touch such a vertex.
   std::array<std::vector<Index>, 2> inside_vertices;
   std::array<std::vector<Index>, 2> overlapping_triangles;
+  /// Status SelfIntersection only: which test left the entry undecided, and where: a vertex
+  /// (reason_features[1] kNoIndex) or, for SheetsNotSeparated, the pair's two triangles.
+  PdReason reason = PdReason::None;
+  std::array<Index, 2> reason_features{kNoIndex, kNoIndex};
 };
 
 /// CCD (paper 3.2, 5.3): a vertex–face pair that collides between frame k and k+1. Ids index

@@ -171,7 +171,8 @@ enum class VertexSide : std::uint8_t {
   Decided,       ///< w_out computed
   OnOtherSheet,  ///< v lies on a face that does not contain it (another sheet passes through v)
   FoldedStar,    ///< w_out depends on the star face it is read from: v's star folds through itself
-  Undecided,     ///< every face of the star is degenerate, or another face covers one coplanarly
+  DegenerateStar,  ///< every face of the star is degenerate: undecided
+  CoveredStar,     ///< a face of the star is covered coplanarly by another (folded flat): undecided
 };
 
 /// v's two other corners in face f, in f's cyclic order from v.
@@ -246,7 +247,7 @@ VertexSide outward_winding(const ObjectView& view, Index v, const Keep& keep, in
   });
   if (on) return VertexSide::OnOtherSheet;
   const Adjacency& adj = adjacency(*o.topology);
-  if (star_is_covered(o, v, adj.vertex_triangles(v))) return VertexSide::Undecided;
+  if (star_is_covered(o, v, adj.vertex_triangles(v))) return VertexSide::CoveredStar;
   // The faces the ray from v can cross (the faces near the symbolic point contain v).
   AABB ray;
   ray.lo = p;
@@ -271,7 +272,7 @@ VertexSide outward_winding(const ObjectView& view, Index v, const Keep& keep, in
     w_out = w;
     any = true;
   }
-  if (!any) return VertexSide::Undecided;
+  if (!any) return VertexSide::DegenerateStar;
   return folded ? VertexSide::FoldedStar : VertexSide::Decided;
 }
 
@@ -344,6 +345,9 @@ struct SelfContext {
       if (r == component_of_triangle(it->tri_b)) crosses_itself[static_cast<size_t>(r)] = 1;
     }
   }
+
+  /// The vertex whose w_out reference_of(v) reads: the largest of v's component.
+  Index reference_vertex(Index v) const { return top[static_cast<size_t>(component[static_cast<size_t>(v)])]; }
 
   /// w_out of a single-sheet vertex of v's component (0 or -1), or kUndecided.
   int reference_of(Index v) {
@@ -760,12 +764,23 @@ PenetrationDepth self_contact_depth(SelfContext& ctx, Index object, const std::v
   std::sort(partners.begin(), partners.end());
 
   bool undecided = false;
+  // The reason given is that of the smallest undecided vertex of the walk (each counts as not
+  // inside, so which vertices the walk classifies does not depend on the order it meets them).
+  Index undecided_vertex = kNoIndex;
   const Walk walk = walk_from(o, hit, [&](Index v) {
     const int ref = ctx.reference_of(v);
     int w = 0;
     const VertexSide s = outward_winding(view, v, [](Index) { return true; }, w);
-    if (ref == SelfContext::kUndecided || s == VertexSide::Undecided) {
+    const bool ref_undecided = ref == SelfContext::kUndecided;
+    if (ref_undecided || s == VertexSide::DegenerateStar || s == VertexSide::CoveredStar) {
       undecided = true;
+      if (undecided_vertex == kNoIndex || v < undecided_vertex) {
+        undecided_vertex = v;
+        pd.reason = ref_undecided ? PdReason::ReferenceVertex
+                    : s == VertexSide::DegenerateStar ? PdReason::DegenerateStar
+                                                      : PdReason::FlatFold;
+        pd.reason_features = {ref_undecided ? ctx.reference_vertex(v) : v, kNoIndex};
+      }
       return false;
     }
     return s == VertexSide::Decided && w != ref;
@@ -836,7 +851,12 @@ PenetrationDepth self_contact_depth(SelfContext& ctx, Index object, const std::v
       }
     }
     for (const IntersectingPair& p : pairs)
-      if (in_region(p.tri_a) && in_region(p.tri_b)) undecided = true;
+      if (in_region(p.tri_a) && in_region(p.tri_b)) {
+        undecided = true;
+        pd.reason = PdReason::SheetsNotSeparated;
+        pd.reason_features = {p.tri_a, p.tri_b};
+        break;
+      }
     if (undecided) break;
     std::sort(touching[c].begin(), touching[c].end());
     touching[c].erase(std::unique(touching[c].begin(), touching[c].end()), touching[c].end());
@@ -855,6 +875,8 @@ PenetrationDepth self_contact_depth(SelfContext& ctx, Index object, const std::v
       const Nearest near = nearest_point(p, view, slack, own_sheet);
       if (near.triangle == kNoIndex) {  // the own sheet is the whole object
         undecided = true;
+        pd.reason = PdReason::WholeObject;
+        pd.reason_features = {v, kNoIndex};
         break;
       }
       // Ties: the smallest vertex id (the floods come in the order of their first seed

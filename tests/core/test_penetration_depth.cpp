@@ -5,6 +5,7 @@
 // separate objects (the inter-object twin).
 #include "core/query/intersecting_pairs.hpp"
 #include "core/geometry/exact_distance.hpp"
+#include "core/geometry/predicates.hpp"
 #include "core/geometry/point_triangle.hpp"
 #include "core/geometry/triangle_intersection.hpp"
 #include "core/mesh/adjacency.hpp"
@@ -760,6 +761,8 @@ TEST(PenetrationDepthSelf, DentPushedThroughTheBottomIsAnInwardFold) {
       EXPECT_LE(std::abs(pd[0].depth - d), 1e-9 * d) << "depth " << pd[0].depth;
       EXPECT_LE((pd[0].direction - Vec3(0, 0, 1)).norm(), 1e-12) << pd[0].direction.transpose();
       EXPECT_EQ(pd[0].deepest_vertex, tip);
+      EXPECT_EQ(pd[0].reason, PdReason::None);
+      EXPECT_EQ(pd[0].reason_features, (std::array<Index, 2>{kNoIndex, kNoIndex}));
       EXPECT_EQ(pd[0].inside_vertices[0], std::vector<Index>{tip});
       ASSERT_EQ(pd[0].inside_vertices[1].size(), 1u);  // the bottom's centre, in the dent
       EXPECT_EQ(o.positions[static_cast<size_t>(pd[0].inside_vertices[1][0])], Vec3(1.5, 1.5, 0));
@@ -778,11 +781,88 @@ TEST(PenetrationDepthSelf, StarFoldedFlatAtASeedIsUndecided) {
     if (p == Vec3(1.5, 1.5, 3)) p = Vec3(1.5, 1.5, -0.7);
     else if (p == Vec3(1.5, 1.5, 0)) p = Vec3(1.5, -0.375, 0);
   }
+  Index moved = kNoIndex;
+  for (Index v = 0; v < dented.num_vertices(); ++v)
+    if (dented.positions[static_cast<size_t>(v)] == Vec3(1.5, -0.375, 0)) moved = v;
+  ASSERT_NE(moved, kNoIndex);
+  const Adjacency& adj = adjacency(*dented.topology);
   for (const Object& o : {dented, flip_all(dented)}) {
     const auto pd = run_pd(frame_of({o}));
     ASSERT_EQ(pd.size(), 1u);
     EXPECT_EQ(pd[0].status, PdStatus::SelfIntersection) << pd_status_name(pd[0].status);
+    // The reason: a flat fold, at the moved vertex or a vertex of its ring (the turned-over
+    // triangles are in their stars too), whose star has two faces in one plane.
+    EXPECT_EQ(pd[0].reason, PdReason::FlatFold) << pd_reason_name(pd[0].reason);
+    const Index at = pd[0].reason_features[0];
+    EXPECT_EQ(pd[0].reason_features[1], kNoIndex);
+    bool near_moved = at == moved;
+    for (Index t : adj.vertex_triangles(moved))
+      for (Index u : o.topology->faces[static_cast<size_t>(t)]) near_moved = near_moved || u == at;
+    EXPECT_TRUE(near_moved) << at;
+    bool coplanar_pair = false;
+    for (Index f : adj.vertex_triangles(at))
+      for (Index g : adj.vertex_triangles(at)) {
+        const Triangle tf = o.triangle(f);
+        if (f == g) continue;
+        bool all = true;
+        for (const Vec3& x : o.triangle(g)) all = all && orient3d(tf[0], tf[1], tf[2], x) == 0;
+        coplanar_pair = coplanar_pair || all;
+      }
+    EXPECT_TRUE(coplanar_pair);
   }
+}
+
+/// A box [0,3]^3 of 2 cells per axis with a degenerate "pillow" attached at the centre of its
+/// -x face a: faces (v, a, b) and (v, b, a) with v the midpoint of a and b, a closed,
+/// oriented two-face surface of zero area (vertex a is then shared by two fans; every edge
+/// is still used once in each direction). The segment a-b crosses the box's surface, so the
+/// pillow's faces intersect a face of the box that does not contain a.
+struct Pillowed {
+  Object object;
+  Index v = kNoIndex, b = kNoIndex;
+};
+Pillowed pillowed_box(const Vec3& b_position) {
+  Object box = make_box(Vec3::Zero(), Vec3::Constant(3), 2, "pillowed");
+  Index a = kNoIndex;
+  for (Index k = 0; k < box.num_vertices(); ++k)
+    if (box.positions[static_cast<size_t>(k)] == Vec3(0, 1.5, 1.5)) a = k;
+  EXPECT_NE(a, kNoIndex);
+  std::vector<Vec3> positions = box.positions;
+  std::vector<Face> faces = box.topology->faces;
+  Pillowed out;
+  out.v = static_cast<Index>(positions.size());
+  positions.push_back(0.5 * (positions[static_cast<size_t>(a)] + b_position));  // exact: dyadic
+  out.b = static_cast<Index>(positions.size());
+  positions.push_back(b_position);
+  faces.push_back({out.v, a, out.b});
+  faces.push_back({out.v, out.b, a});
+  out.object = literal_object(positions, faces, "pillowed");
+  return out;
+}
+
+TEST(PenetrationDepthSelf, DegenerateStarIsTheReason) {
+  // The pillow leaves through the +y face (b at x = 2: the box's corner (3, 3, 3) stays the
+  // lexicographically largest vertex, whose w_out is decided). v and b have only the pillow's
+  // faces, which have no normal: undecided, reason degenerate_star at the smaller of them.
+  const Pillowed p = pillowed_box(Vec3(2, 4, 1.375));
+  ASSERT_TRUE(closed_and_oriented(p.object));
+  const auto pd = run_pd(frame_of({p.object}));
+  ASSERT_EQ(pd.size(), 1u);
+  ASSERT_EQ(pd[0].status, PdStatus::SelfIntersection) << pd_status_name(pd[0].status);
+  EXPECT_EQ(pd[0].reason, PdReason::DegenerateStar) << pd_reason_name(pd[0].reason);
+  EXPECT_EQ(pd[0].reason_features, (std::array<Index, 2>{std::min(p.v, p.b), kNoIndex}));
+}
+
+TEST(PenetrationDepthSelf, UndecidedReferenceVertexIsTheReason) {
+  // The pillow leaves through the +x face: b, at x = 4, is now the component's largest vertex,
+  // where its w_out is read, and its star is degenerate: reason reference_vertex, at b.
+  const Pillowed p = pillowed_box(Vec3(4, 1.25, 1.375));
+  ASSERT_TRUE(closed_and_oriented(p.object));
+  const auto pd = run_pd(frame_of({p.object}));
+  ASSERT_EQ(pd.size(), 1u);
+  ASSERT_EQ(pd[0].status, PdStatus::SelfIntersection) << pd_status_name(pd[0].status);
+  EXPECT_EQ(pd[0].reason, PdReason::ReferenceVertex) << pd_reason_name(pd[0].reason);
+  EXPECT_EQ(pd[0].reason_features, (std::array<Index, 2>{p.b, kNoIndex}));
 }
 
 /// PD of boxes a and b as two objects (the twin) and as one object of two components (self),
