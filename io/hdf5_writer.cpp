@@ -47,6 +47,8 @@ struct PdRow {  // one object pair's penetration depth
   double direction[3];
   std::int32_t deepest_object, deepest_vertex;  // -1: direction from a face normal
   double deepest_point[3], nearest_point[3];
+  std::uint8_t reason;                // PdReason code (README), 0 unless self_intersection
+  std::int32_t reason_a, reason_b;    // its vertex (and -1) or triangle pair; -1 = none
 };
 
 struct FeatureRow {  // one overlapping feature of one pd row
@@ -260,7 +262,9 @@ struct Hdf5ResultWriter::Impl {
                     i32("deepest_object", offsetof(PdRow, deepest_object)),
                     i32("deepest_vertex", offsetof(PdRow, deepest_vertex)),
                     {"deepest_point", offsetof(PdRow, deepest_point), point_mem, point_file},
-                    {"nearest_point", offsetof(PdRow, nearest_point), point_mem, point_file}},
+                    {"nearest_point", offsetof(PdRow, nearest_point), point_mem, point_file},
+                    {"reason", offsetof(PdRow, reason), H5T_NATIVE_UINT8, H5T_STD_U8LE},
+                    i32("reason_a", offsetof(PdRow, reason_a)), i32("reason_b", offsetof(PdRow, reason_b))},
                    sizeof(PdRow), pd_mem_type, pd_file_type);
     build_compound({i32("pair", offsetof(FeatureRow, pair)), i32("object", offsetof(FeatureRow, object)),
                     i32("vertex", offsetof(FeatureRow, id))},
@@ -290,6 +294,9 @@ struct Hdf5ResultWriter::Impl {
       row.object_a = p.objects[0];
       row.object_b = p.objects[1];
       row.status = static_cast<std::uint8_t>(p.status);
+      row.reason = static_cast<std::uint8_t>(p.reason);
+      row.reason_a = p.reason_features[0];
+      row.reason_b = p.reason_features[1];
       row.depth = ok ? p.depth : kNaN;
       row.deepest_object = ok ? p.deepest_object : kNoIndex;
       row.deepest_vertex = ok ? p.deepest_vertex : kNoIndex;

@@ -54,6 +54,7 @@ Json pd_json(const PenetrationDepth& p) {
     r["depth"] = nullptr;
     r["direction"] = nullptr;
     r["status"] = pd_status_name(p.status);
+    if (p.reason != PdReason::None) r["reason"] = pd_reason_name(p.reason);
   }
   return r;
 }

@@ -6,11 +6,13 @@
 #include "io/mesh_reader.hpp"
 #include "io/scene_source.hpp"
 #include "support/cli.hpp"
+#include "support/pd_checks.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <map>
 
 namespace vproxq {
 namespace {
@@ -109,6 +111,45 @@ TEST(PdTwoCubes, CliWritesPairsAndDepth) {
       EXPECT_EQ(verts.size(), pd[p].inside_vertices[0].size() + pd[p].inside_vertices[1].size());
     }
   }
+}
+
+TEST(PdSelf, CliWritesTheReasonOfEachSelfIntersectionEntry) {
+  // The tiny bowl scene (sample_scenes/bowl-tiny, soft letters in a bowl): its self entries
+  // with and without a number. Each entry of the JSON and HDF5 output is the core's for the
+  // frame, with "reason" (and HDF5's reason, reason_a, reason_b) on self_intersection entries
+  // only, and each reason holds (tests/support/pd_checks.hpp).
+  ScratchDir dir;
+  const fs::path scene = fs::path(VPROXQ_SAMPLE_SCENES_DIR) / "bowl-tiny" / "scene.json";
+  const auto r = test::vproxq(quote(scene) + " --queries=pd --threads 2 --quiet -o " + quote(dir / "out"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json j = test::read_json(dir / "out" / "results.json");
+  Hdf5Reader h5(dir / "out" / "results.h5");
+  const SceneSource source = SceneSource::open(scene);
+  std::map<std::string, int> seen;
+  for (size_t k = 0; k < j["frames"].size(); ++k) {
+    SCOPED_TRACE("frame " + std::to_string(k));
+    const Frame frame = source.load_frame(k);
+    const auto pairs = intersecting_pairs_brute_force(frame).pairs;
+    const auto pd = penetration_depth(frame, FrameBoxes::compute(frame, 1), pairs, {1}).pairs;
+    const auto& fj = j["frames"][k]["pd"];
+    ASSERT_EQ(fj.size(), pd.size());
+    const std::string ds = "/frames/00000" + std::to_string(k) + "/pd/pairs";
+    ASSERT_EQ(h5.rows(ds), pd.size());
+    const auto reason = h5.int_field(ds, "reason"), ra = h5.int_field(ds, "reason_a"), rb = h5.int_field(ds, "reason_b");
+    for (size_t p = 0; p < pd.size(); ++p) {
+      test::expect_reason_holds(frame, pd[p], pairs);
+      const bool undecided = pd[p].status == PdStatus::SelfIntersection;
+      EXPECT_EQ(fj[p].contains("reason"), undecided);
+      if (undecided) EXPECT_EQ(fj[p]["reason"], pd_reason_name(pd[p].reason));
+      EXPECT_EQ(reason[p], static_cast<int>(pd[p].reason));
+      EXPECT_EQ(ra[p], pd[p].reason_features[0]);
+      EXPECT_EQ(rb[p], pd[p].reason_features[1]);
+      ++seen[undecided ? pd_reason_name(pd[p].reason) : pd_status_name(pd[p].status)];
+    }
+  }
+  // What the scene holds (README, "Where it gives no number"): a number on three frames, one
+  // pair of sheets the curve does not separate.
+  EXPECT_EQ(seen, (std::map<std::string, int>{{"ok", 3}, {"sheets_not_separated", 1}}));
 }
 
 TEST(PdTwoCubes, CliReportsStatusInsteadOfNumber) {
