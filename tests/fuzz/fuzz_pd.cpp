@@ -210,6 +210,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const double tolerance = 0x1p-40 * magnitude;
   const PenetrationDepth* inter = nullptr;
   for (const PenetrationDepth& e : pd) {
+    test::expect_reason_holds(frame, e, pairs);
     if (e.objects[0] == e.objects[1]) continue;  // a jittered object intersecting itself: no crash, same for all threads
     inter = &e;
     if (e.status != PdStatus::Ok && e.status != PdStatus::TooDeep) continue;
@@ -263,6 +264,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto self = run_pd(one, self_pairs, 1);
   test::expect_same_pd(self, run_pd(one, self_pairs, 2), "self, threads 1 vs 2");
   EXPECT_EQ(self.size(), 1u);
+  for (const PenetrationDepth& e : self) test::expect_reason_holds(one, e, self_pairs);
   if (self.size() != 1 || self[0].status == PdStatus::SelfIntersection) return 0;
   const PenetrationDepth& s = self[0];
   EXPECT_EQ(s.status, inter->status) << pd_status_name(s.status) << " vs " << pd_status_name(inter->status);

@@ -2,9 +2,12 @@
 // Brute-force checks of penetration-depth entries between two objects, shared by the PD tests
 // (tests/core/test_penetration_depth.cpp) and the PD fuzz harness (tests/fuzz/fuzz_pd.cpp):
 // the deepest vertex by exact max-min over every face, the inside vertices against the
-// brute-force winding number, and the comparison of two results field by field.
+// brute-force winding number, what a self_intersection entry's reason says, and the
+// comparison of two results field by field.
 #include "core/geometry/exact_distance.hpp"
 #include "core/geometry/point_triangle.hpp"
+#include "core/geometry/predicates.hpp"
+#include "core/geometry/triangle_intersection.hpp"
 #include "core/mesh/adjacency.hpp"
 #include "core/query/penetration_depth.hpp"
 
@@ -13,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace vproxq::test {
@@ -152,6 +156,81 @@ inline bool has_swallowed_set(const Frame& frame, const PenetrationDepth& e) {
   return false;
 }
 
+/// An entry has a reason exactly when it is self_intersection, and the reason's feature has
+/// the property it names (README, "Where it gives no number"): degenerate_star, a vertex of
+/// the object all of whose faces are degenerate; flat_fold, a vertex two of whose faces lie in
+/// one plane; reference_vertex, the lexicographically largest vertex (x, y, z, then id) of its
+/// mesh component; sheets_not_separated, an intersecting pair of the object; whole_object,
+/// a vertex of the object. `pairs`: the frame's intersecting pairs.
+inline void expect_reason_holds(const Frame& frame, const PenetrationDepth& e,
+                                const std::vector<IntersectingPair>& pairs) {
+  if (e.status != PdStatus::SelfIntersection) {
+    EXPECT_EQ(e.reason, PdReason::None) << pd_reason_name(e.reason);
+    EXPECT_EQ(e.reason_features, (std::array<Index, 2>{kNoIndex, kNoIndex}));
+    return;
+  }
+  SCOPED_TRACE(std::string("reason ") + pd_reason_name(e.reason));
+  ASSERT_EQ(e.objects[0], e.objects[1]);
+  const Object& o = frame.objects[static_cast<size_t>(e.objects[0])];
+  const auto [a, b] = e.reason_features;
+  if (e.reason == PdReason::SheetsNotSeparated) {
+    const IntersectingPair p{e.objects[0], std::min(a, b), e.objects[0], std::max(a, b)};
+    EXPECT_TRUE(a != b && std::find(pairs.begin(), pairs.end(), p) != pairs.end()) << a << " " << b;
+    return;
+  }
+  EXPECT_EQ(b, kNoIndex);
+  ASSERT_TRUE(a >= 0 && a < o.num_vertices()) << a;
+  std::vector<Index> star;
+  for (Index t = 0; t < o.num_triangles(); ++t) {
+    const Face& f = o.topology->faces[static_cast<size_t>(t)];
+    if (f[0] == a || f[1] == a || f[2] == a) star.push_back(t);
+  }
+  ASSERT_FALSE(star.empty());
+  switch (e.reason) {
+    case PdReason::DegenerateStar:
+      for (Index t : star) EXPECT_TRUE(triangle_is_degenerate(o.triangle(t))) << t;
+      break;
+    case PdReason::FlatFold: {
+      bool coplanar = false;
+      for (Index f : star)
+        for (Index g : star) {
+          const Triangle tf = o.triangle(f), tg = o.triangle(g);
+          if (f == g || triangle_is_degenerate(tf) || triangle_is_degenerate(tg)) continue;
+          bool all = true;
+          for (const Vec3& x : tg) all = all && orient3d(tf[0], tf[1], tf[2], x) == 0;
+          coplanar = coplanar || all;
+        }
+      EXPECT_TRUE(coplanar) << a;
+      break;
+    }
+    case PdReason::ReferenceVertex: {
+      // a's component: the vertices reached from a across faces.
+      std::vector<char> in(static_cast<size_t>(o.num_vertices()), 0);
+      in[static_cast<size_t>(a)] = 1;
+      for (bool grew = true; grew;) {
+        grew = false;
+        for (const Face& f : o.topology->faces)
+          if ((in[static_cast<size_t>(f[0])] || in[static_cast<size_t>(f[1])] || in[static_cast<size_t>(f[2])]) &&
+              !(in[static_cast<size_t>(f[0])] && in[static_cast<size_t>(f[1])] && in[static_cast<size_t>(f[2])])) {
+            for (Index v : f) in[static_cast<size_t>(v)] = 1;
+            grew = true;
+          }
+      }
+      const Vec3& pa = o.positions[static_cast<size_t>(a)];
+      for (Index v = 0; v < o.num_vertices(); ++v) {
+        const Vec3& pv = o.positions[static_cast<size_t>(v)];
+        if (in[static_cast<size_t>(v)])
+          EXPECT_TRUE(std::tie(pa.x(), pa.y(), pa.z(), a) >= std::tie(pv.x(), pv.y(), pv.z(), v)) << a << " vs " << v;
+      }
+      break;
+    }
+    case PdReason::WholeObject:
+      break;
+    default:
+      ADD_FAILURE() << "self_intersection without a reason";
+  }
+}
+
 /// Two results of the same frame are the same, every field (NaN equal to NaN).
 inline void expect_same_pd(const std::vector<PenetrationDepth>& a, const std::vector<PenetrationDepth>& b,
                            const std::string& what) {
@@ -170,6 +249,8 @@ inline void expect_same_pd(const std::vector<PenetrationDepth>& a, const std::ve
     EXPECT_TRUE(same_vec(a[k].nearest_point, b[k].nearest_point));
     EXPECT_EQ(a[k].inside_vertices, b[k].inside_vertices);
     EXPECT_EQ(a[k].overlapping_triangles, b[k].overlapping_triangles);
+    EXPECT_EQ(a[k].reason, b[k].reason);
+    EXPECT_EQ(a[k].reason_features, b[k].reason_features);
   }
 }
 
