@@ -89,6 +89,12 @@ void frame_summary(std::string& out, const FrameResult& r) {
       if (p.status == PdStatus::Ok)
         appendf(out, "  pd %d-%d: depth %.17g direction (%.6g, %.6g, %.6g)\n", p.objects[0], p.objects[1], p.depth,
                 p.direction.x(), p.direction.y(), p.direction.z());
+      else if (p.reason == PdReason::SheetsNotSeparated)
+        appendf(out, "  pd %d-%d: %s (%s: triangles %d and %d)\n", p.objects[0], p.objects[1], pd_status_name(p.status),
+                pd_reason_name(p.reason), p.reason_features[0], p.reason_features[1]);
+      else if (p.reason != PdReason::None)
+        appendf(out, "  pd %d-%d: %s (%s: vertex %d)\n", p.objects[0], p.objects[1], pd_status_name(p.status),
+                pd_reason_name(p.reason), p.reason_features[0]);
       else
         appendf(out, "  pd %d-%d: %s\n", p.objects[0], p.objects[1], pd_status_name(p.status));
     }

@@ -150,6 +150,16 @@ TEST(PdSelf, CliWritesTheReasonOfEachSelfIntersectionEntry) {
   // What the scene holds (README, "Where it gives no number"): a number on three frames, one
   // pair of sheets the curve does not separate.
   EXPECT_EQ(seen, (std::map<std::string, int>{{"ok", 3}, {"sheets_not_separated", 1}}));
+  // The terminal summary names the reason and where.
+  const auto summary = test::vproxq(quote(scene) + " --queries=pd --threads 2 --frames 0:1");
+  ASSERT_EQ(summary.exit_code, 0) << summary.output;
+  const Frame frame = source.load_frame(0);
+  const auto pd = penetration_depth(frame, FrameBoxes::compute(frame, 1), intersecting_pairs_brute_force(frame).pairs, {1}).pairs;
+  ASSERT_EQ(pd.size(), 1u);
+  const std::string line = "pd " + std::to_string(pd[0].objects[0]) + "-" + std::to_string(pd[0].objects[1]) +
+                           ": self_intersection (sheets_not_separated: triangles " + std::to_string(pd[0].reason_features[0]) +
+                           " and " + std::to_string(pd[0].reason_features[1]) + ")\n";
+  EXPECT_NE(summary.output.find(line), std::string::npos) << line << summary.output;
 }
 
 TEST(PdTwoCubes, CliReportsStatusInsteadOfNumber) {
