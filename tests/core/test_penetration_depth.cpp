@@ -840,29 +840,23 @@ Pillowed pillowed_box(const Vec3& b_position) {
   return out;
 }
 
-TEST(PenetrationDepthSelf, DegenerateStarIsTheReason) {
-  // The pillow leaves through the +y face (b at x = 2: the box's corner (3, 3, 3) stays the
-  // lexicographically largest vertex, whose w_out is decided). v and b have only the pillow's
-  // faces, which have no normal: undecided, reason degenerate_star at the smaller of them.
-  const Pillowed p = pillowed_box(Vec3(2, 4, 1.375));
-  ASSERT_TRUE(closed_and_oriented(p.object));
-  const auto pd = run_pd(frame_of({p.object}));
-  ASSERT_EQ(pd.size(), 1u);
-  ASSERT_EQ(pd[0].status, PdStatus::SelfIntersection) << pd_status_name(pd[0].status);
-  EXPECT_EQ(pd[0].reason, PdReason::DegenerateStar) << pd_reason_name(pd[0].reason);
-  EXPECT_EQ(pd[0].reason_features, (std::array<Index, 2>{std::min(p.v, p.b), kNoIndex}));
-}
-
-TEST(PenetrationDepthSelf, UndecidedReferenceVertexIsTheReason) {
-  // The pillow leaves through the +x face: b, at x = 4, is now the component's largest vertex,
+TEST(PenetrationDepthSelf, UndecidedPillowGivesItsReason) {
+  // Where the pillow leaves through the +y face (b at x = 2), the box's corner (3, 3, 3) stays
+  // the lexicographically largest vertex, whose w_out is decided; v and b have only the
+  // pillow's faces, which have no normal: reason degenerate_star, at the smaller of them.
+  // Where it leaves through the +x face (b at x = 4), b is the component's largest vertex,
   // where its w_out is read, and its star is degenerate: reason reference_vertex, at b.
-  const Pillowed p = pillowed_box(Vec3(4, 1.25, 1.375));
-  ASSERT_TRUE(closed_and_oriented(p.object));
-  const auto pd = run_pd(frame_of({p.object}));
-  ASSERT_EQ(pd.size(), 1u);
-  ASSERT_EQ(pd[0].status, PdStatus::SelfIntersection) << pd_status_name(pd[0].status);
-  EXPECT_EQ(pd[0].reason, PdReason::ReferenceVertex) << pd_reason_name(pd[0].reason);
-  EXPECT_EQ(pd[0].reason_features, (std::array<Index, 2>{p.b, kNoIndex}));
+  for (const bool through_x : {false, true}) {
+    SCOPED_TRACE(through_x ? "through +x" : "through +y");
+    const Pillowed p = pillowed_box(through_x ? Vec3(4, 1.25, 1.375) : Vec3(2, 4, 1.375));
+    ASSERT_TRUE(closed_and_oriented(p.object));
+    const auto pd = run_pd(frame_of({p.object}));
+    ASSERT_EQ(pd.size(), 1u);
+    ASSERT_EQ(pd[0].status, PdStatus::SelfIntersection) << pd_status_name(pd[0].status);
+    EXPECT_EQ(pd[0].reason, through_x ? PdReason::ReferenceVertex : PdReason::DegenerateStar)
+        << pd_reason_name(pd[0].reason);
+    EXPECT_EQ(pd[0].reason_features, (std::array<Index, 2>{through_x ? p.b : std::min(p.v, p.b), kNoIndex}));
+  }
 }
 
 /// PD of boxes a and b as two objects (the twin) and as one object of two components (self),
