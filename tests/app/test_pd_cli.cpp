@@ -140,7 +140,9 @@ TEST(PdSelf, CliWritesTheReasonOfEachSelfIntersectionEntry) {
       test::expect_reason_holds(frame, pd[p], pairs);
       const bool undecided = pd[p].status == PdStatus::SelfIntersection;
       EXPECT_EQ(fj[p].contains("reason"), undecided);
-      if (undecided) EXPECT_EQ(fj[p]["reason"], pd_reason_name(pd[p].reason));
+      if (undecided) {
+        EXPECT_EQ(fj[p]["reason"], pd_reason_name(pd[p].reason));
+      }
       EXPECT_EQ(reason[p], static_cast<int>(pd[p].reason));
       EXPECT_EQ(ra[p], pd[p].reason_features[0]);
       EXPECT_EQ(rb[p], pd[p].reason_features[1]);

@@ -219,8 +219,9 @@ inline void expect_reason_holds(const Frame& frame, const PenetrationDepth& e,
       const Vec3& pa = o.positions[static_cast<size_t>(a)];
       for (Index v = 0; v < o.num_vertices(); ++v) {
         const Vec3& pv = o.positions[static_cast<size_t>(v)];
-        if (in[static_cast<size_t>(v)])
+        if (in[static_cast<size_t>(v)]) {
           EXPECT_TRUE(std::tie(pa.x(), pa.y(), pa.z(), a) >= std::tie(pv.x(), pv.y(), pv.z(), v)) << a << " vs " << v;
+        }
       }
       break;
     }
