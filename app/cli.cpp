@@ -201,6 +201,13 @@ int diff_main(int argc, char** argv) {
       ->check(tolerance());
   app.add_option("--atol", opts.atol, "absolute tolerance for numbers (default 0)")
       ->check(tolerance());
+  app.add_option("--ignore", opts.ignore,
+                 "a member name to leave out wherever it occurs, e.g. a key added in a later version "
+                 "(repeatable; comma-separated lists too)")
+      ->delimiter(',')
+      ->check(CLI::Validator(
+          [](std::string& key) { return key.empty() ? std::string("an empty key name") : std::string(); },
+          "KEY", "non-empty"));
   app.set_version_flag("--version", std::string("vproxq ") + VPROXQ_VERSION);
   bool done = false;
   const int code = parse_or_exit(app, argc, argv, done);
@@ -208,7 +215,9 @@ int diff_main(int argc, char** argv) {
   return guarded([&] {
     const DiffOutcome out = diff_result_files(a, b, opts);
     if (out.equal) {
-      std::printf("identical (ignoring stats, version, settings)\n");
+      std::string ignored = "stats, version, settings";
+      for (const std::string& key : opts.ignore) ignored += ", " + key;
+      std::printf("identical (ignoring %s)\n", ignored.c_str());
       return exit_code::kOk;
     }
     std::printf("different: %s\n", out.first_difference.c_str());

@@ -127,7 +127,10 @@ class Differ {
 
   template <class Ignored>
   std::optional<std::string> objects(const Json& a, const Json& b, const std::string& path,
-                                     Ignored ignored) {
+                                     Ignored ignored_here) {
+    auto ignored = [&](const std::string& key) {
+      return ignored_here(key) || std::find(opts_.ignore.begin(), opts_.ignore.end(), key) != opts_.ignore.end();
+    };
     for (auto it = a.begin(); it != a.end(); ++it) {
       if (ignored(it.key())) continue;
       const std::string sub = member_path(path, it.key());

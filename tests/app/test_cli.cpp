@@ -672,6 +672,14 @@ TEST(Cli, RepeatedRunsAreIdenticalAndDiffDetectsChanges) {
   EXPECT_NE(r.output.find("distance"), std::string::npos) << r.output;
   r = vproxq("diff " + quote(a) + " " + quote(dir / "c.json") + " --rtol 1e-6");
   EXPECT_EQ(r.exit_code, 0) << r.output;
+  // Or the member left out wherever it occurs; the output names what was ignored.
+  r = vproxq("diff " + quote(a) + " " + quote(dir / "c.json") + " --ignore inter,intra --ignore points");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("identical (ignoring stats, version, settings, inter, intra, points)"), std::string::npos) << r.output;
+  r = vproxq("diff " + quote(a) + " " + quote(dir / "c.json") + " --ignore intra");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  r = vproxq("diff " + quote(a) + " " + quote(dir / "c.json") + " --ignore=");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
   // A subnormal tolerance is a finite number >= 0 too (accepted, and far too small here).
   r = vproxq("diff " + quote(a) + " " + quote(dir / "c.json") + " --atol=1e-310");
   EXPECT_EQ(r.exit_code, 1) << r.output;

@@ -123,6 +123,36 @@ TEST_F(DiffTest, StatsVersionAndSettingsAreIgnored) {
   EXPECT_TRUE(diff(base_document(), b).equal);
 }
 
+TEST_F(DiffTest, IgnoredMembersAreLeftOutAtEveryDepth) {
+  // A key that one file has and the other lacks (a key added in a later version), deep inside
+  // a frame: a difference, unless ignored.
+  Json b = base_document();
+  b["frames"][0]["distance"]["inter"][0]["reason"] = "added";
+  DiffOutcome d = diff(base_document(), b);
+  EXPECT_FALSE(d.equal);
+  EXPECT_EQ(d.first_difference, "frame 0 (frames[0]), distance.inter[0].reason: (missing) vs \"added\"");
+  DiffOptions opts;
+  opts.ignore = {"reason"};
+  EXPECT_TRUE(diff(base_document(), b, opts).equal);
+  EXPECT_TRUE(diff(b, base_document(), opts).equal);
+  // A name is left out at every depth where it occurs: "distance" is a frame's member and an
+  // inter entry's; a change elsewhere still shows.
+  Json c = base_document();
+  c["frames"][0]["distance"]["inter"][1]["distance"] = 0.25;
+  c["frames"][2].erase("distance");
+  opts.ignore = {"distance"};
+  EXPECT_TRUE(diff(base_document(), c, opts).equal);
+  c["frames"][1]["objects"][0]["triangles"] = 2;
+  d = diff(base_document(), c, opts);
+  EXPECT_FALSE(d.equal);
+  EXPECT_EQ(d.first_difference, "frame 1 (frames[1]), objects[0].triangles: 1 vs 2");
+  // Top-level members too.
+  Json e = base_document();
+  e["scene"] = "skirt";
+  opts.ignore = {"reason", "scene"};
+  EXPECT_TRUE(diff(base_document(), e, opts).equal);
+}
+
 TEST_F(DiffTest, DistanceBeyondToleranceDiffersWithReadablePath) {
   Json b = base_document();
   b["frames"][0]["distance"]["inter"][1]["distance"] = 0.25;
@@ -192,7 +222,7 @@ TEST_F(DiffTest, IntegersAreComparedExactlyWhateverTheTolerance) {
 TEST_F(DiffTest, NullVersusNumberDiffers) {
   Json b = base_document();
   b["frames"][2]["distance"]["inter"][0]["distance"] = 1.5;
-  const DiffOutcome d = diff(base_document(), b, {1e9, 1e9});
+  const DiffOutcome d = diff(base_document(), b, {1e9, 1e9, {}});
   EXPECT_FALSE(d.equal);
   EXPECT_EQ(d.first_difference, "frame 3 (frames[2]), distance.inter[0].distance: null vs 1.5");
 }
