@@ -180,11 +180,7 @@ inline void expect_reason_holds(const Frame& frame, const PenetrationDepth& e,
   }
   EXPECT_EQ(b, kNoIndex);
   ASSERT_TRUE(a >= 0 && a < o.num_vertices()) << a;
-  std::vector<Index> star;
-  for (Index t = 0; t < o.num_triangles(); ++t) {
-    const Face& f = o.topology->faces[static_cast<size_t>(t)];
-    if (f[0] == a || f[1] == a || f[2] == a) star.push_back(t);
-  }
+  const IndexSpan star = adjacency(*o.topology).vertex_triangles(a);
   ASSERT_FALSE(star.empty());
   switch (e.reason) {
     case PdReason::DegenerateStar:
