@@ -11,8 +11,28 @@
 // distances the candidates have in common, and builds points for the winner only. Everything
 // is straight-line double arithmetic without heap allocation, so equal inputs give bitwise
 // equal outputs.
+//
+// Pruning. triangle_distance() skips a candidate that provably cannot win: one whose features'
+// boxes (a corner's point box, an edge's box, the other triangle's box) are farther apart than
+// r = sqrt(closest) + m, where `closest` is the smallest of the 18 corner-to-edge squared
+// distances and m = 2^-30 S (S: the largest coordinate magnitude of the 6 corners). Every
+// candidate's computed distance lies within 16 e S of its exact value, e = 2^-53 (the bound
+// tests/core/test_triangle_distance.cpp checks for the primitives against a long-double twin,
+// measured at most about 5 e S; 2^-49 S), so
+//   - a skipped candidate computes to more than its exact value minus 2^-49 S, which is at
+//     least its boxes' distance, which exceeds r (up to a few roundings of r, below 2^-48 S):
+//     more than sqrt(closest) + m - 2^-47 S;
+//   - the winner computes to at most the exact triangle distance plus 2^-49 S (the candidate
+//     that realises it computes to no more), which is at most the exact distance of the
+//     corner-to-edge pair behind `closest`, itself within 2^-49 S of sqrt(closest).
+// As m = 2^-30 S is far above these roundings, a skipped candidate computes to strictly more
+// than the winner: it would not have replaced the best, and skipping it changes nothing. Every
+// other candidate is evaluated as before, in the same order, so the result is bitwise that of
+// the search over all 15 (detail::triangle_distance_unpruned(), the twin the tests compare
+// it with). A triangle whose vertex candidates are all skipped is not prepared at all.
 #include "core/geometry/triangle_distance.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -40,9 +60,30 @@ double point_triangle_squared(const detail::PointTrianglePlan& plan, const doubl
   return best;
 }
 
-}  // namespace
+/// Pruning margin per unit of the coordinates' magnitude (m above).
+constexpr double kPruneMargin = 0x1p-30;
 
-TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b) {
+/// The box of n points.
+struct Box3 {
+  Vec3 lo, hi;
+};
+inline Box3 box_of(const Vec3& p, const Vec3& q) { return {p.cwiseMin(q), p.cwiseMax(q)}; }
+inline Box3 box_of(const Triangle& t) { return {t[0].cwiseMin(t[1]).cwiseMin(t[2]), t[0].cwiseMax(t[1]).cwiseMax(t[2])}; }
+
+/// Squared distance between two boxes (0 where they overlap), rounded: within a few e of the
+/// exact value, relatively.
+inline double box_gap_squared(const Box3& p, const Box3& q) {
+  double sum = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double gap = detail::max_value(0.0, detail::max_value(q.lo[k] - p.hi[k], p.lo[k] - q.hi[k]));
+    sum += gap * gap;
+  }
+  return sum;
+}
+
+/// The 15-candidate search, with or without pruning (see the top of the file).
+template <bool kPrune>
+TriangleDistanceResult search(const Triangle& a, const Triangle& b) {
   TriangleDistanceResult r;
   const IntersectionResult hit = triangle_intersection(a, b);
   if (hit.intersecting) {
@@ -70,19 +111,58 @@ TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b) {
     winner = better ? candidate : winner;
     best = detail::select(better, squared, best);
   };
-  const PreparedTriangle prepared_b = prepare_triangle(b);
-  for (int i = 0; i < 3; ++i) {
-    offer(point_triangle_squared(detail::plan_point_triangle(a[i], prepared_b), a_to_b[i]), i);
+  // Pruning: a candidate whose features' boxes are more than r apart (squared: limit) is
+  // skipped; without it, limit stays infinite and nothing is.
+  double limit = kInfinity, wlimit = kInfinity;
+  Box3 box_a{}, box_b{};
+  double pa[3] = {0, 0, 0}, pb[3] = {0, 0, 0};
+  if constexpr (kPrune) {
+    double closest = kInfinity, scale = 0;
+    for (int i = 0; i < 3; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        closest = detail::min_value(closest, detail::min_value(a_to_b[i][k], b_to_a[i][k]));
+        scale = detail::max_value(scale, detail::max_value(std::fabs(a[i][k]), std::fabs(b[i][k])));
+      }
+    }
+    const double r = std::sqrt(closest) + kPruneMargin * scale;
+    limit = r * r;
+    box_a = box_of(a);
+    box_b = box_of(b);
+    const Vec3 w = (b[0] + b[1] + b[2]) - (a[0] + a[1] + a[2]);
+    for (int i = 0; i < 3; ++i) {
+      pa[i] = w.dot(a[i]);
+      pb[i] = w.dot(b[i]);
+    }
+    wlimit = r * std::sqrt(w.squaredNorm());
   }
-  const PreparedTriangle prepared_a = prepare_triangle(a);
+  auto skipped = [&](const Box3& p, const Box3& q) { return kPrune && box_gap_squared(p, q) > limit; };
+  auto apart = [&](double a_hi, double b_lo) { return kPrune && b_lo - a_hi > wlimit; };
+  // Each triangle is prepared when a vertex candidate against it is evaluated first.
+  PreparedTriangle prepared_a, prepared_b;
+  bool have_a = false, have_b = false;
+  auto prepared = [](const Triangle& t, PreparedTriangle& p, bool& have) -> const PreparedTriangle& {
+    if (!have) {
+      p = prepare_triangle(t);
+      have = true;
+    }
+    return p;
+  };
+  for (int i = 0; i < 3; ++i) {
+    if (apart(pa[i], std::min({pb[0], pb[1], pb[2]})) || skipped({a[i], a[i]}, box_b)) continue;
+    offer(point_triangle_squared(detail::plan_point_triangle(a[i], prepared(b, prepared_b, have_b)), a_to_b[i]), i);
+  }
   for (int j = 0; j < 3; ++j) {
-    offer(point_triangle_squared(detail::plan_point_triangle(b[j], prepared_a), b_to_a[j]),
+    if (apart(std::max({pa[0], pa[1], pa[2]}), pb[j]) || skipped({b[j], b[j]}, box_a)) continue;
+    offer(point_triangle_squared(detail::plan_point_triangle(b[j], prepared(a, prepared_a, have_a)), b_to_a[j]),
           kFirstFaceVertex + j);
   }
   for (int ea = 0; ea < 3; ++ea) {
     const int ea1 = (ea + 1) % 3;
     for (int eb = 0; eb < 3; ++eb) {
       const int eb1 = (eb + 1) % 3;
+      if (apart(std::max(pa[ea], pa[ea1]), std::min(pb[eb], pb[eb1])) ||
+          skipped(box_of(a[ea], a[ea1]), box_of(b[eb], b[eb1])))
+        continue;
       const detail::SegmentInteriorCore interior =
           detail::segment_interior_core(a[ea], a[ea1], b[eb], b[eb1]);
       // The boundary's value (which endpoint wins does not matter for the value).
@@ -99,7 +179,7 @@ TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b) {
   }
   // Points of the winner only, from the stand-alone primitive (its squared distance is the
   // one found above, bitwise).
-  if (winner < kFirstFaceVertex) {
+  if (winner < kFirstFaceVertex) {  // evaluated, so its triangle is prepared
     r.point_a = a[winner];
     r.point_b = point_triangle_distance(a[winner], prepared_b).closest;
     r.kind = TriangleDistanceCase::VertexFace;
@@ -130,5 +210,15 @@ TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b) {
   if (r.distance == 0.0) r.distance = std::numeric_limits<double>::denorm_min();
   return r;
 }
+
+}  // namespace
+
+TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b) { return search<true>(a, b); }
+
+namespace detail {
+TriangleDistanceResult triangle_distance_unpruned(const Triangle& a, const Triangle& b) {
+  return search<false>(a, b);
+}
+}  // namespace detail
 
 }  // namespace vproxq

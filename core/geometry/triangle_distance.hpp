@@ -43,6 +43,12 @@ struct TriangleDistanceResult {
 /// holds for coordinates of magnitude in [2^-200, 2^200] or zero (predicates.hpp).
 TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b);
 
+namespace detail {
+/// triangle_distance() without its pruning: all 15 candidates are evaluated. Bitwise the same
+/// result (triangle_distance.cpp says why); the twin the tests compare triangle_distance with.
+TriangleDistanceResult triangle_distance_unpruned(const Triangle& a, const Triangle& b);
+}  // namespace detail
+
 /// r seen from the other triangle's side: points, features and the vertex–face case swapped.
 inline TriangleDistanceResult swapped(TriangleDistanceResult r) {
   std::swap(r.point_a, r.point_b);

@@ -179,11 +179,25 @@ double reported_distance(double squared) {
   return d == 0.0 ? std::numeric_limits<double>::denorm_min() : d;
 }
 
+/// triangle_distance's pruning skips only candidates that cannot win: r is bitwise the result
+/// of the search over all 15 candidates.
+void expect_same_as_unpruned(const Triangle& a, const Triangle& b, const TriangleDistanceResult& r) {
+  const TriangleDistanceResult all = detail::triangle_distance_unpruned(a, b);
+  EXPECT_EQ(std::memcmp(&r.distance, &all.distance, sizeof r.distance), 0)
+      << "distance " << r.distance << ", without pruning " << all.distance;
+  EXPECT_EQ(r.point_a, all.point_a);
+  EXPECT_EQ(r.point_b, all.point_b);
+  EXPECT_EQ(r.kind, all.kind);
+  EXPECT_EQ(r.feature_a, all.feature_a);
+  EXPECT_EQ(r.feature_b, all.feature_b);
+}
+
 /// All checks of one triangle pair against the twin; returns the result.
 TriangleDistanceResult check_pair(const Triangle& a, const Triangle& b, ErrorStats* stats = nullptr) {
   const double unit = kEpsilon * scale_of(a, b);
   const double tol = kTolUlps * unit;
   const TriangleDistanceResult r = triangle_distance(a, b);
+  expect_same_as_unpruned(a, b, r);
   const TwinResult twin = twin_hull_distance(as_points(a), as_points(b));
   const bool intersect = triangles_intersect(a, b);
   const auto d_twin = static_cast<double>(twin.distance);
@@ -942,6 +956,61 @@ TEST(TriangleDistance, DeterministicBitwise) {
   }
 }
 
+/// The triangles of a bumpy height field over an n x n grid of vertices (spacing 1), with
+/// coordinates times `scale` plus `offset`; `integer` keeps them on the integer grid (many
+/// candidates of a pair then tie exactly), otherwise they are jittered.
+std::vector<std::array<int, 3>> height_field(int n, std::vector<Vec3>& vertices, std::mt19937_64& rng, bool integer,
+                                             double scale, double offset) {
+  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
+  vertices.clear();
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      Vec3 p(i, j, std::round(2 * std::sin(0.7 * i) * std::cos(0.5 * j)));
+      if (!integer) p += Vec3(jitter(rng), jitter(rng), jitter(rng));
+      vertices.push_back(p * scale + Vec3::Constant(offset));
+    }
+  }
+  std::vector<std::array<int, 3>> faces;
+  for (int i = 0; i + 1 < n; ++i) {
+    for (int j = 0; j + 1 < n; ++j) {
+      const int v = i * n + j;
+      faces.push_back({v, v + n, v + 1});
+      faces.push_back({v + 1, v + n, v + n + 1});
+    }
+  }
+  return faces;
+}
+
+TEST(TriangleDistance, PruningOnMeshNeighboursIsTheFullSearch) {
+  // Where the pruning skips most candidates: triangles of one mesh that share no vertex and
+  // lie within a few edges of each other (the pairs of the intra-object distance), on the
+  // integer grid (exact ties between candidates) and jittered, at scales 2^-100 to 2^100 and
+  // far from the origin. Every result must be bitwise that of the search over all 15.
+  std::mt19937_64 rng(35);
+  int pairs = 0;
+  for (bool integer : {true, false}) {
+    for (auto [scale, offset] : {std::pair{1.0, 0.0}, std::pair{0x1p-100, 0.0}, std::pair{0x1p100, 0.0},
+                                 std::pair{1.0, 1e6}, std::pair{1e-3, 1e3}}) {
+      std::vector<Vec3> v;
+      const auto faces = height_field(10, v, rng, integer, scale, offset);
+      for (size_t f = 0; f < faces.size(); ++f) {
+        for (size_t g = 0; g < faces.size(); ++g) {
+          bool shared = false;
+          for (int x : faces[f])
+            for (int y : faces[g]) shared |= x == y;
+          const Triangle a{v[faces[f][0]], v[faces[f][1]], v[faces[f][2]]};
+          const Triangle b{v[faces[g][0]], v[faces[g][1]], v[faces[g][2]]};
+          if (f == g || shared || (a[0] - b[0]).norm() > 3.5 * scale) continue;
+          expect_same_as_unpruned(a, b, triangle_distance(a, b));
+          ++pairs;
+          if (::testing::Test::HasFailure()) FAIL() << "integer " << integer << " scale " << scale << " pair " << f << ", " << g;
+        }
+      }
+    }
+  }
+  EXPECT_GT(pairs, 10000);
+}
+
 /// Micro-benchmark, not a test: run with
 ///   tests_core --gtest_also_run_disabled_tests --gtest_filter='*DISABLED_Benchmark*'
 /// Each chunk of 32 pairs is timed separately and its fastest of many rounds is kept: this
@@ -949,38 +1018,59 @@ TEST(TriangleDistance, DeterministicBitwise) {
 /// a chunk keep the branch predictor from learning the data.
 TEST(TriangleDistance, DISABLED_Benchmark) {
   std::mt19937_64 rng(34);
-  constexpr int kPairs = 8192;
   constexpr int kChunk = 32;
   constexpr int kRounds = 100;
-  auto run = [&](const char* name, double spread) {
-    std::vector<std::pair<Triangle, Triangle>> pairs;
-    int intersecting = 0;
-    for (int i = 0; i < kPairs; ++i) {
-      const Triangle a = random_triangle(rng, Vec3::Zero(), 1.0);
-      const Triangle b = random_triangle(rng, random_vec(rng, spread), 1.0);
-      pairs.emplace_back(a, b);
-      intersecting += triangles_intersect(a, b);
-    }
-    std::vector<double> fastest(kPairs / kChunk, kInfinity);
+  // ns per call of f over the pairs (the fastest of kRounds per chunk, summed).
+  auto time_calls = [&](const std::vector<std::pair<Triangle, Triangle>>& pairs, auto f) {
+    const size_t chunks = pairs.size() / kChunk;
+    std::vector<double> fastest(chunks, kInfinity);
     double sink = 0;
     for (int round = 0; round < kRounds; ++round) {
-      for (int c = 0; c < kPairs / kChunk; ++c) {
+      for (size_t c = 0; c < chunks; ++c) {
         const auto start = std::chrono::steady_clock::now();
-        for (int i = c * kChunk; i < (c + 1) * kChunk; ++i) {
-          sink += triangle_distance(pairs[i].first, pairs[i].second).distance;
-        }
+        for (size_t i = c * kChunk; i < (c + 1) * kChunk; ++i) sink += f(pairs[i].first, pairs[i].second).distance;
         const std::chrono::duration<double, std::nano> elapsed = std::chrono::steady_clock::now() - start;
         fastest[c] = std::min(fastest[c], elapsed.count());
       }
     }
     double total = 0;
     for (double t : fastest) total += t;
-    std::printf("[ bench ] %s: %.1f ns per triangle_distance call (%d of %d pairs intersect; %g)\n",
-                name, total / kPairs, intersecting, kPairs, sink > 0 ? 1.0 : 0.0);
+    return sink >= 0 ? total / static_cast<double>(chunks * kChunk) : 0.0;
   };
-  run("nearby (unit triangles, centres within +-2)", 2.0);
-  run("touching range (centres within +-1)", 1.0);
-  run("separated (centres within +-6)", 6.0);
+  auto report = [&](const char* name, const std::vector<std::pair<Triangle, Triangle>>& pairs) {
+    int intersecting = 0;
+    for (const auto& [a, b] : pairs) intersecting += triangles_intersect(a, b);
+    std::printf("[ bench ] %s: %.1f ns per triangle_distance call, %.1f without pruning (%d of %zu pairs intersect)\n",
+                name, time_calls(pairs, [](const Triangle& a, const Triangle& b) { return triangle_distance(a, b); }),
+                time_calls(pairs, [](const Triangle& a, const Triangle& b) { return detail::triangle_distance_unpruned(a, b); }),
+                intersecting, pairs.size());
+  };
+  auto random_pairs = [&](double spread) {
+    std::vector<std::pair<Triangle, Triangle>> pairs;
+    for (int i = 0; i < 8192; ++i) pairs.emplace_back(random_triangle(rng, Vec3::Zero(), 1.0), random_triangle(rng, random_vec(rng, spread), 1.0));
+    return pairs;
+  };
+  report("nearby (unit triangles, centres within +-2)", random_pairs(2.0));
+  report("touching range (centres within +-1)", random_pairs(1.0));
+  report("separated (centres within +-6)", random_pairs(6.0));
+  // The intra-object distance's pairs: triangles of one jittered height field that share no
+  // vertex, within a few edges of each other, in a shuffled order.
+  std::vector<Vec3> v;
+  const auto faces = height_field(40, v, rng, false, 1.0, 0.0);
+  std::vector<std::pair<Triangle, Triangle>> mesh;
+  for (size_t f = 0; f < faces.size(); ++f) {
+    for (size_t g = f + 1; g < faces.size(); ++g) {
+      bool shared = false;
+      for (int x : faces[f])
+        for (int y : faces[g]) shared |= x == y;
+      const Triangle a{v[faces[f][0]], v[faces[f][1]], v[faces[f][2]]};
+      const Triangle b{v[faces[g][0]], v[faces[g][1]], v[faces[g][2]]};
+      if (!shared && (a[0] - b[0]).norm() <= 2.5) mesh.emplace_back(a, b);
+    }
+  }
+  std::shuffle(mesh.begin(), mesh.end(), rng);
+  mesh.resize(std::min<size_t>(mesh.size(), 8192));
+  report("mesh neighbours (non-adjacent, within 2.5 edges)", mesh);
 }
 
 }  // namespace

@@ -27,6 +27,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -338,6 +339,16 @@ inline std::string check_slab_pair(const SlabPair& s, double* worst = nullptr) {
     const Triangle& y = order == 0 ? s.b : s.a;
     const char* name = order == 0 ? "triangle_distance(a, b)" : "triangle_distance(b, a)";
     const TriangleDistanceResult r = triangle_distance(x, y);
+    // Its pruning skips only candidates that cannot win: bitwise the search over all 15.
+    const TriangleDistanceResult all = detail::triangle_distance_unpruned(x, y);
+    if (std::memcmp(&r.distance, &all.distance, sizeof r.distance) != 0 || r.point_a != all.point_a ||
+        r.point_b != all.point_b || r.kind != all.kind || r.feature_a != all.feature_a ||
+        r.feature_b != all.feature_b) {
+      fail << name << ": distance " << r.distance << " (kind " << static_cast<int>(r.kind) << ", features "
+           << int{r.feature_a} << ", " << int{r.feature_b} << ") but without pruning " << all.distance << " (kind "
+           << static_cast<int>(all.kind) << ", features " << int{all.feature_a} << ", " << int{all.feature_b} << ")";
+      return fail.str();
+    }
     const bool intersecting = r.kind == TriangleDistanceCase::Intersecting;
     if (intersecting != contact || triangles_intersect(x, y) != contact) {
       fail << name << ": reported " << (intersecting ? "" : "not ") << "intersecting, triangles_intersect "
