@@ -38,7 +38,8 @@ struct TriangleDistanceResult {
 /// and the reported points are theirs. Distances are accurate to a few ulps of the largest
 /// coordinate (they are computed from coordinate differences); points are rounded to their
 /// coordinates' grid. For intersecting triangles point_a == point_b is one common point,
-/// computed approximately (within a few ulps of both triangles). Deterministic: equal inputs
+/// computed approximately (within a few ulps of both triangles). Feature pairs that provably
+/// cannot win are skipped, which changes no bit of the result. Deterministic: equal inputs
 /// give bitwise equal results. Inputs must be finite; exactness of the intersection decision
 /// holds for coordinates of magnitude in [2^-200, 2^200] or zero (predicates.hpp).
 TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b);
