@@ -279,6 +279,9 @@ void run(const Config& config) {
   info.queries = queries;
   info.voronoi = config.voronoi;
   info.threads = resolve_threads(config.threads);
+  info.self = config.self;
+  if (!config.self && !want_distance && !config.quiet)
+    std::fprintf(stderr, "vproxq: note: --self has no effect without the distance query\n");
   info.frame_count = static_cast<std::size_t>(last - first);
   const int grid = config.grid > 0 ? config.grid : scene.grid().value_or(0);
   VoronoiStage voronoi = make_voronoi_stage(config, info.threads);
@@ -344,14 +347,15 @@ void run(const Config& config) {
         result.time_ms.exact = d.exact_ms;
         result.counters = d.counters;
         result.inter = std::move(d.per_object);
-        run_intra(frame, boxes, voronoi, grid, info.threads, result, static_intra, intra_pairs, intra_left_out);
+        if (config.self)
+          run_intra(frame, boxes, voronoi, grid, info.threads, result, static_intra, intra_pairs, intra_left_out);
       }
       // Discrete collisions (paper 3.2), then local penetration depth (3.3) from them; their
       // time counts as exact tests. The pairs within the objects that the intra-object
       // distance searched come from its exact tests (it meets every such pair).
       sw.restart();
       IntersectingPairsOptions ip_options{info.threads, opts.voronoi, true};
-      if (want_distance) {
+      if (want_distance && config.self) {
         ip_options.intra_pairs = &intra_pairs;
         ip_options.intra_skip = &intra_left_out;
       }

@@ -297,6 +297,7 @@ struct RunInfo {
   int grid = 0;                      ///< 0: no grid (voronoi off)
   std::string device;                ///< renderer string, or "" without GPU
   int threads = 1;
+  bool self = true;             ///< whether "distance" ran its intra-object part (--self)
   std::size_t frame_count = 0;  ///< frames that will be written
 };
 

@@ -687,6 +687,7 @@ Hdf5ResultWriter::Hdf5ResultWriter(const std::filesystem::path& file, const RunI
   m.write_attribute(root, "/", "grid", std::int32_t{info.grid});
   m.write_attribute(root, "/", "device", info.device);
   m.write_attribute(root, "/", "threads", std::int32_t{info.threads});
+  m.write_attribute(root, "/", "self", std::int32_t{info.self ? 1 : 0});
   m.frames = m.create_group(root, "frames", "/frames");
 }
 

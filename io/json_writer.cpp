@@ -176,6 +176,7 @@ Json run_header_json(const RunInfo& info) {
   settings["grid"] = info.grid == 0 ? Json(nullptr) : Json(info.grid);
   settings["device"] = info.device.empty() ? Json(nullptr) : Json(info.device);
   settings["threads"] = info.threads;
+  settings["self"] = info.self;
   j["settings"] = std::move(settings);
   return j;
 }

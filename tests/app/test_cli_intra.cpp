@@ -1,5 +1,6 @@
 // End-to-end: the CLI's distance.intra (JSON) and distance/intra (HDF5) equal the library's
 // brute force, with every Stage II backend.
+#include "core/query/intersecting_pairs.hpp"
 #include "core/query/intra_distance.hpp"
 #include "core/voronoi/self_stage2.hpp"
 #include "io/hdf5_reader.hpp"
@@ -10,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 
@@ -168,6 +170,67 @@ TEST(CliIntra, StaticObjectsAreComputedOnceAndEqualBruteForceOnEveryFrame) {
               alone["frames"][0]["stats"]["intra_exact_tests"].get<std::uint64_t>());
     EXPECT_EQ(j["frames"][2]["distance"]["intra"], alone["frames"][0]["distance"]["intra"]);
   }
+}
+
+TEST(CliIntra, SelfOffLeavesOutTheIntraObjectPartAlone) {
+  // --self off: the distance query without its intra-object part. The tiny bowl has pairs of
+  // intersecting triangles within its soft letters and self PD entries: they must still be
+  // found (by the intersecting-pair search instead of the intra-object one), every other answer
+  // must be the full run's, and nothing of the intra-object part may be written.
+  ScratchDir dir;
+  const fs::path scene = fs::path(VPROXQ_SAMPLE_SCENES_DIR) / "bowl-tiny" / "scene.json";
+  const std::string common = quote(scene) + " --queries=distance,pd --threads 2 --quiet -o ";
+  const auto on = vproxq(common + quote(dir / "on"));
+  ASSERT_EQ(on.exit_code, 0) << on.output;
+  const auto off = vproxq(common + quote(dir / "off") + " --self off");
+  ASSERT_EQ(off.exit_code, 0) << off.output;
+  const auto same = vproxq("diff --ignore intra " + quote(dir / "on" / "results.json") + " " + quote(dir / "off" / "results.json"));
+  EXPECT_EQ(same.exit_code, 0) << same.output;
+  const auto differs = vproxq("diff " + quote(dir / "on" / "results.json") + " " + quote(dir / "off" / "results.json"));
+  EXPECT_EQ(differs.exit_code, 1) << differs.output;  // only through distance.intra
+
+  const nlohmann::json j = read_json(dir / "off" / "results.json");
+  EXPECT_EQ(j["settings"]["self"], false);
+  EXPECT_EQ(read_json(dir / "on" / "results.json")["settings"]["self"], true);
+  Hdf5Reader h5(dir / "off" / "results.h5");
+  EXPECT_EQ(h5.int_attribute("/", "self"), 0);
+  const SceneSource source = SceneSource::open(scene);
+  size_t within_objects = 0;
+  for (size_t k = 0; k < j["frames"].size(); ++k) {
+    SCOPED_TRACE("frame " + std::to_string(k));
+    const nlohmann::json& f = j["frames"][k];
+    EXPECT_FALSE(f["distance"].contains("intra"));
+    EXPECT_TRUE(f["distance"].contains("inter"));
+    EXPECT_FALSE(f["stats"].contains("intra_exact_tests"));
+    EXPECT_FALSE(f["stats"]["time_ms"].contains("intra_exact"));
+    const std::string g = "/frames/00000" + std::to_string(k);
+    EXPECT_FALSE(h5.exists(g + "/distance/intra"));
+    EXPECT_FALSE(h5.exists(g + "/distance/intra_min"));
+    EXPECT_TRUE(h5.exists(g + "/distance/inter"));
+    // Every intersecting pair, within objects too: the brute force's list, row by row.
+    const auto pairs = intersecting_pairs_brute_force(source.load_frame(k)).pairs;
+    const std::string ds = g + "/intersecting_pairs";
+    ASSERT_EQ(h5.rows(ds), pairs.size());
+    EXPECT_EQ(f["distance"]["intersecting_pairs"].get<size_t>(), pairs.size());
+    const auto oa = h5.int_field(ds, "object_a"), ta = h5.int_field(ds, "tri_a");
+    const auto ob = h5.int_field(ds, "object_b"), tb = h5.int_field(ds, "tri_b");
+    std::vector<IntersectingPair> written;
+    for (size_t r = 0; r < pairs.size(); ++r)
+      written.push_back({static_cast<Index>(oa[r]), static_cast<Index>(ta[r]), static_cast<Index>(ob[r]), static_cast<Index>(tb[r])});
+    std::sort(written.begin(), written.end());
+    EXPECT_EQ(written, pairs);
+    for (const IntersectingPair& p : pairs) within_objects += p.object_a == p.object_b;
+  }
+  EXPECT_GT(within_objects, 0u);  // the scene does test the pairs within objects
+
+  // Without the distance query the option changes nothing, and says so; a bad value is a
+  // usage error.
+  const auto note = vproxq(quote(scene) + " --queries=pd --frames 0:1 --self off");
+  EXPECT_EQ(note.exit_code, 0) << note.output;
+  EXPECT_NE(note.output.find("--self has no effect without the distance query"), std::string::npos) << note.output;
+  const auto bad = vproxq(quote(scene) + " --self maybe -o " + quote(dir / "bad"));
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_FALSE(fs::exists(dir / "bad"));
 }
 
 }  // namespace

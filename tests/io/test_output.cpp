@@ -181,8 +181,9 @@ TEST_F(OutputTest, JsonHeaderHasExactlyTheDocumentedKeys) {
   EXPECT_EQ(doc["scene"], "bowl");
   EXPECT_EQ(doc["queries"], json::array({"distance", "ccd"}));
   EXPECT_EQ(keys_of(doc["settings"]),
-            (std::set<std::string>{"voronoi", "grid", "device", "threads"}));
+            (std::set<std::string>{"voronoi", "grid", "device", "threads", "self"}));
   EXPECT_EQ(doc["settings"]["voronoi"], "cpu");
+  EXPECT_EQ(doc["settings"]["self"], true);
   EXPECT_EQ(doc["settings"]["grid"], 64);
   EXPECT_TRUE(doc["settings"]["device"].is_null());
   EXPECT_EQ(doc["settings"]["threads"], 3);
@@ -317,7 +318,8 @@ TEST_F(OutputTest, Hdf5RootAttributesCarryTheSettings) {
   Hdf5Reader h5(out() / "results.h5");
   EXPECT_EQ(h5.attribute_names("/"),
             (std::vector<std::string>{"device", "format_version", "grid", "queries", "scene",
-                                      "scene_path", "threads", "tool", "version", "voronoi"}));
+                                      "scene_path", "self", "threads", "tool", "version", "voronoi"}));
+  EXPECT_EQ(h5.int_attribute("/", "self"), 1);
   EXPECT_EQ(h5.string_attribute("/", "tool"), "vproxq");
   EXPECT_EQ(h5.string_attribute("/", "version"), VPROXQ_VERSION);
   EXPECT_EQ(h5.int_attribute("/", "format_version"), 1);
