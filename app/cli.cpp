@@ -288,10 +288,11 @@ int cli_main(int argc, char** argv) {
       ->check(whole_number(1, kMaxGridResolution, "cells along the longest axis"));
   app.add_option("--device", config.device, "EGL device index for --voronoi=gpu (default: first hardware device)")
       ->check(whole_number(0, 1023, "an EGL device index"));
-  std::string self = "on";
+  std::string self;
   app.add_option("--self", self,
-                 "the distance query's intra-object (\"self\") part: on (default), or off for the "
-                 "inter-object distance and the intersecting pairs alone")
+                 "the distance query's intra-object (\"self\") part: on, or off for the "
+                 "inter-object distance and the intersecting pairs alone (default: the scene's "
+                 "\"self\", else on)")
       ->check(CLI::IsMember({"on", "off"}));
   app.add_option("--threads", config.threads, "worker threads (default 0: all cores)")
       ->check(whole_number(0, kMaxThreads, "0: all cores"));
@@ -302,7 +303,7 @@ int cli_main(int argc, char** argv) {
   if (done) return code;
   return guarded([&] {
     if (!frames.empty()) config.frames = parse_frame_range(frames);
-    config.self = self == "on";
+    if (app.count("--self") > 0) config.self = self == "on";
     if (app.count("--queries") > 0) config.queries = parse_query_list(queries);
     g_out_of_memory_hint = config.voronoi == "off" ? "" : "; a coarser --grid or --ccd-grid (or --voronoi=off) needs less";
     // With -o the results files are the run's product, and stdout and stderr carry only notes

@@ -21,7 +21,7 @@ struct Config {
   int ccd_grid = 0;              ///< CCD's Stage II grid, cells along the longest axis; 0: automatic
   int device = -1;               ///< EGL device index for gpu; -1: prefer a hardware device
   int threads = 0;               ///< 0: all hardware threads
-  bool self = true;              ///< the distance query's intra-object ("self") part
+  std::optional<bool> self;      ///< the distance query's intra-object part; unset: scene's "self", else on
   bool quiet = false;
 };
 

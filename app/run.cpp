@@ -279,8 +279,9 @@ void run(const Config& config) {
   info.queries = queries;
   info.voronoi = config.voronoi;
   info.threads = resolve_threads(config.threads);
-  info.self = config.self;
-  if (!config.self && !want_distance && !config.quiet)
+  const bool self = config.self.value_or(scene.self().value_or(true));
+  info.self = self;
+  if (config.self == false && !want_distance && !config.quiet)
     std::fprintf(stderr, "vproxq: note: --self has no effect without the distance query\n");
   info.frame_count = static_cast<std::size_t>(last - first);
   const int grid = config.grid > 0 ? config.grid : scene.grid().value_or(0);
@@ -347,7 +348,7 @@ void run(const Config& config) {
         result.time_ms.exact = d.exact_ms;
         result.counters = d.counters;
         result.inter = std::move(d.per_object);
-        if (config.self)
+        if (self)
           run_intra(frame, boxes, voronoi, grid, info.threads, result, static_intra, intra_pairs, intra_left_out);
       }
       // Discrete collisions (paper 3.2), then local penetration depth (3.3) from them; their
@@ -355,7 +356,7 @@ void run(const Config& config) {
       // distance searched come from its exact tests (it meets every such pair).
       sw.restart();
       IntersectingPairsOptions ip_options{info.threads, opts.voronoi, true};
-      if (want_distance && config.self) {
+      if (want_distance && self) {
         ip_options.intra_pairs = &intra_pairs;
         ip_options.intra_skip = &intra_left_out;
       }

@@ -313,6 +313,7 @@ struct SceneSource::Impl {
   std::string name;
   std::vector<std::string> queries;
   std::optional<int> grid;
+  std::optional<bool> self;
   ObjectSplit split = ObjectSplit::Meshes;
   bool per_object = false;          ///< "objects" is an array of per-object sequences
   std::vector<Sequence> sequences;  ///< one, or one per object when per_object
@@ -354,7 +355,7 @@ void parse_scene_json(SceneImpl& s) {
   if (!root.is_object())
     throw InputError(where + ": the scene must be a JSON object, got " + shown(root));
   const SceneParser p(s.path);
-  p.check_keys(root, "", {"name", "frames", "objects", "static", "queries", "grid"});
+  p.check_keys(root, "", {"name", "frames", "objects", "static", "queries", "grid", "self"});
 
   s.name = root.contains("name") ? p.string(root["name"], "name") : s.path.stem().string();
 
@@ -426,6 +427,10 @@ void parse_scene_json(SceneImpl& s) {
   if (root.contains("grid")) {
     const std::string what = "an integer in [1, " + std::to_string(kMaxGridResolution) + "]";
     s.grid = static_cast<int>(p.integer(root["grid"], "grid", 1, kMaxGridResolution, what.c_str()));
+  }
+  if (root.contains("self")) {
+    if (!root["self"].is_boolean()) p.fail("self", "must be true or false, got " + shown(root["self"]));
+    s.self = root["self"].get<bool>();
   }
 
   if (root.contains("static")) {
@@ -573,6 +578,7 @@ void SceneSource::require_frames(std::size_t first, std::size_t last) const {
 }
 const std::vector<std::string>& SceneSource::queries() const { return impl_->queries; }
 std::optional<int> SceneSource::grid() const { return impl_->grid; }
+std::optional<bool> SceneSource::self() const { return impl_->self; }
 ObjectSplit SceneSource::split() const { return impl_->split; }
 
 }  // namespace vproxq

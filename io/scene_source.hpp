@@ -55,6 +55,8 @@ class SceneSource {
   /// kMaxGridResolution).
   const std::vector<std::string>& queries() const;
   std::optional<int> grid() const;
+  /// scene.json "self" (nullopt when absent): whether "distance" runs its intra-object part.
+  std::optional<bool> self() const;
   ObjectSplit split() const;
 
   /// Reads frame k (0-based position in the sequence): all objects, then the static ones.

@@ -223,6 +223,22 @@ TEST(CliIntra, SelfOffLeavesOutTheIntraObjectPartAlone) {
   }
   EXPECT_GT(within_objects, 0u);  // the scene does test the pairs within objects
 
+  // The scene's "self": false does the same, and --self on overrides it.
+  fs::copy(scene.parent_path(), dir / "own", fs::copy_options::recursive);
+  const fs::path own = dir / "own" / "scene.json";
+  nlohmann::json scene_json = read_json(own);
+  scene_json["self"] = false;
+  std::ofstream(own) << scene_json.dump();
+  const auto by_scene = vproxq(quote(own) + " --queries=distance,pd --threads 2 --quiet -o " + quote(dir / "by_scene"));
+  ASSERT_EQ(by_scene.exit_code, 0) << by_scene.output;
+  EXPECT_EQ(read_json(dir / "by_scene" / "results.json")["settings"]["self"], false);
+  const auto as_off = vproxq("diff " + quote(dir / "off" / "results.json") + " " + quote(dir / "by_scene" / "results.json"));
+  EXPECT_EQ(as_off.exit_code, 0) << as_off.output;
+  const auto forced = vproxq(quote(own) + " --queries=distance,pd --threads 2 --quiet --self on -o " + quote(dir / "forced"));
+  ASSERT_EQ(forced.exit_code, 0) << forced.output;
+  const auto as_on = vproxq("diff " + quote(dir / "on" / "results.json") + " " + quote(dir / "forced" / "results.json"));
+  EXPECT_EQ(as_on.exit_code, 0) << as_on.output;
+
   // Without the distance query the option changes nothing, and says so; a bad value is a
   // usage error.
   const auto note = vproxq(quote(scene) + " --queries=pd --frames 0:1 --self off");

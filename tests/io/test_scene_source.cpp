@@ -53,6 +53,7 @@ TEST_F(SceneSourceTest, PatternFramesLoadOnRequest) {
   EXPECT_EQ(s.frame_count(), 3u);
   EXPECT_EQ(s.queries(), (std::vector<std::string>{"distance", "ccd"}));
   EXPECT_EQ(s.grid(), 64);
+  EXPECT_EQ(s.self(), std::nullopt);
   EXPECT_EQ(s.split(), ObjectSplit::Meshes);
 
   const Frame f1 = s.load_frame(1);
@@ -467,6 +468,10 @@ TEST_F(SceneSourceTest, EveryBadKeyIsReported) {
        {"\"grid\" must be an integer in [1, 4096]"}},
       {R"({"frames": {"files": ["a_0.obj"]}, "grid": 4097})",
        {"\"grid\" must be an integer in [1, 4096], got 4097"}},
+      {R"({"frames": {"files": ["a_0.obj"]}, "self": "off"})",
+       {"\"self\" must be true or false, got \"off\""}},
+      {R"({"frames": {"files": ["a_0.obj"]}, "self": 0})",
+       {"\"self\" must be true or false, got 0"}},
   };
   for (const BadScene& c : cases) {
     SCOPED_TRACE(c.json);
