@@ -43,6 +43,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/broad_phase/aabb.hpp"
 #include "core/geometry/point_triangle.hpp"
 #include "core/geometry/segment_segment.hpp"
 #include "core/geometry/triangle_intersection.hpp"
@@ -70,23 +71,8 @@ double point_triangle_squared(const detail::PointTrianglePlan& plan, const doubl
 /// Pruning margin per unit of the coordinates' magnitude (m above).
 constexpr double kPruneMargin = 0x1p-30;
 
-/// The box of a segment's or a triangle's corners.
-struct Box3 {
-  Vec3 lo, hi;
-};
-inline Box3 box_of(const Vec3& p, const Vec3& q) { return {p.cwiseMin(q), p.cwiseMax(q)}; }
-inline Box3 box_of(const Triangle& t) { return {t[0].cwiseMin(t[1]).cwiseMin(t[2]), t[0].cwiseMax(t[1]).cwiseMax(t[2])}; }
-
-/// Squared distance between two boxes (0 where they overlap), rounded: within a few e of the
-/// exact value, relatively.
-inline double box_gap_squared(const Box3& p, const Box3& q) {
-  double sum = 0;
-  for (int k = 0; k < 3; ++k) {
-    const double gap = detail::max_value(0.0, detail::max_value(q.lo[k] - p.hi[k], p.lo[k] - q.hi[k]));
-    sum += gap * gap;
-  }
-  return sum;
-}
+/// The box of a segment's corners.
+inline AABB segment_box(const Vec3& p, const Vec3& q) { return {p.cwiseMin(q), p.cwiseMax(q)}; }
 
 /// The 15-candidate search, with or without pruning (see the top of the file).
 template <bool kPrune>
@@ -121,8 +107,8 @@ TriangleDistanceResult search(const Triangle& a, const Triangle& b) {
   // Pruning: a candidate whose features' boxes are more than r apart (squared: limit) is
   // skipped; without it, limit stays infinite and nothing is.
   double limit = kInfinity, wlimit = kInfinity;
-  Box3 box_a{}, box_b{};
-  double pa[3] = {0, 0, 0}, pb[3] = {0, 0, 0};
+  AABB box_a, box_b;
+  double pa[3] = {0, 0, 0}, pb[3] = {0, 0, 0}, pa_max = 0, pb_min = 0;
   if constexpr (kPrune) {
     double closest = kInfinity, scale = 0;
     for (int i = 0; i < 3; ++i) {
@@ -133,16 +119,18 @@ TriangleDistanceResult search(const Triangle& a, const Triangle& b) {
     }
     const double r = std::sqrt(closest) + kPruneMargin * scale;
     limit = r * r;
-    box_a = box_of(a);
-    box_b = box_of(b);
+    box_a = AABB::of(a);
+    box_b = AABB::of(b);
     const Vec3 w = (b[0] + b[1] + b[2]) - (a[0] + a[1] + a[2]);
     for (int i = 0; i < 3; ++i) {
       pa[i] = w.dot(a[i]);
       pb[i] = w.dot(b[i]);
     }
+    pa_max = std::max({pa[0], pa[1], pa[2]});
+    pb_min = std::min({pb[0], pb[1], pb[2]});
     wlimit = r * std::sqrt(w.squaredNorm());
   }
-  auto skipped = [&](const Box3& p, const Box3& q) { return kPrune && box_gap_squared(p, q) > limit; };
+  auto skipped = [&](const AABB& p, const AABB& q) { return kPrune && box_distance_squared(p, q) > limit; };
   auto apart = [&](double a_hi, double b_lo) { return kPrune && b_lo - a_hi > wlimit; };
   // Each triangle is prepared when a vertex candidate against it is evaluated first.
   PreparedTriangle prepared_a, prepared_b;
@@ -155,11 +143,11 @@ TriangleDistanceResult search(const Triangle& a, const Triangle& b) {
     return p;
   };
   for (int i = 0; i < 3; ++i) {
-    if (apart(pa[i], std::min({pb[0], pb[1], pb[2]})) || skipped({a[i], a[i]}, box_b)) continue;
+    if (apart(pa[i], pb_min) || skipped({a[i], a[i]}, box_b)) continue;
     offer(point_triangle_squared(detail::plan_point_triangle(a[i], prepared(b, prepared_b, have_b)), a_to_b[i]), i);
   }
   for (int j = 0; j < 3; ++j) {
-    if (apart(std::max({pa[0], pa[1], pa[2]}), pb[j]) || skipped({b[j], b[j]}, box_a)) continue;
+    if (apart(pa_max, pb[j]) || skipped({b[j], b[j]}, box_a)) continue;
     offer(point_triangle_squared(detail::plan_point_triangle(b[j], prepared(a, prepared_a, have_a)), b_to_a[j]),
           kFirstFaceVertex + j);
   }
@@ -168,7 +156,7 @@ TriangleDistanceResult search(const Triangle& a, const Triangle& b) {
     for (int eb = 0; eb < 3; ++eb) {
       const int eb1 = (eb + 1) % 3;
       if (apart(std::max(pa[ea], pa[ea1]), std::min(pb[eb], pb[eb1])) ||
-          skipped(box_of(a[ea], a[ea1]), box_of(b[eb], b[eb1])))
+          skipped(segment_box(a[ea], a[ea1]), segment_box(b[eb], b[eb1])))
         continue;
       const detail::SegmentInteriorCore interior =
           detail::segment_interior_core(a[ea], a[ea1], b[eb], b[eb1]);
