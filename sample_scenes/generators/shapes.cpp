@@ -210,8 +210,11 @@ std::vector<P2> glyph_stroke(int glyph, bool& closed) {
     }
     case 2:
     case 3: {  // g: bowl and descender hook
-      Pen p({0.35 + 0.27 * det_cos(45 * kDeg), 0.6 + 0.27 * det_sin(45 * kDeg)});
-      p.arc({0.35, 0.6}, 0.27, 0.27, 45 * kDeg, 360 * kDeg);
+      // The bowl runs clockwise from its lower right to its right side, where the stroke goes
+      // on down into the stem: drawn the other way round it came up that side and went
+      // straight back down, and the tube folded through itself at the turn.
+      Pen p({0.35 + 0.27 * det_cos(-80 * kDeg), 0.6 + 0.27 * det_sin(-80 * kDeg)});
+      p.arc({0.35, 0.6}, 0.27, 0.27, -80 * kDeg, -360 * kDeg);
       p.line_to({0.62, 0.0});
       p.arc({0.37, 0.0}, 0.25, 0.25, 0, -150 * kDeg);
       return p.points();
@@ -222,9 +225,9 @@ std::vector<P2> glyph_stroke(int glyph, bool& closed) {
       p.arc({0.35, 0.45}, 0.25, 0.25, 180 * kDeg, 45 * kDeg);
       return p.points();
     }
-    case 5: {  // a: bowl and stem
-      Pen p({0.33 + 0.25 * det_cos(80 * kDeg), 0.35 + 0.25 * det_sin(80 * kDeg)});
-      p.arc({0.33, 0.35}, 0.25, 0.25, 80 * kDeg, 360 * kDeg);
+    case 5: {  // a: bowl and stem (the bowl clockwise, as for g)
+      Pen p({0.33 + 0.25 * det_cos(-80 * kDeg), 0.35 + 0.25 * det_sin(-80 * kDeg)});
+      p.arc({0.33, 0.35}, 0.25, 0.25, -80 * kDeg, -360 * kDeg);
       p.line_to({0.58, 0.1});
       p.arc({0.68, 0.1}, 0.1, 0.1, 180 * kDeg, 270 * kDeg);
       return p.points();

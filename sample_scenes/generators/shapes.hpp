@@ -44,8 +44,9 @@ Mesh board_mesh(const V3& origin, const V3& u, const V3& v, double half_u, doubl
                 int nv);
 
 /// The letter-like shapes: single pen strokes of the characters of "siggraph06" (a few are
-/// simplified so one stroke draws them without crossing itself), in a box about 0.7 wide and
-/// 1 high, z = 0.
+/// simplified so one stroke draws them without crossing itself or turning back on itself, so
+/// that no letter's tube intersects itself as it starts), in a box about 0.7 wide and 1 high,
+/// z = 0.
 inline constexpr int kGlyphCount = 10;
 char glyph_char(int glyph);
 /// A closed tube (elliptic cross-section: `half_width` in the letter's plane, `half_depth`

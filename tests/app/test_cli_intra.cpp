@@ -173,12 +173,13 @@ TEST(CliIntra, StaticObjectsAreComputedOnceAndEqualBruteForceOnEveryFrame) {
 }
 
 TEST(CliIntra, SelfOffLeavesOutTheIntraObjectPartAlone) {
-  // --self off: the distance query without its intra-object part. The tiny bowl has pairs of
-  // intersecting triangles within its soft letters and self PD entries: they must still be
-  // found (by the intersecting-pair search instead of the intra-object one), every other answer
-  // must be the full run's, and nothing of the intra-object part may be written.
+  // --self off: the distance query without its intra-object part. The folded letters
+  // (tests/data/folded-letters: soft letters in a bowl, one folding through itself) have pairs
+  // of intersecting triangles within one object and self PD entries: they must still be found
+  // (by the intersecting-pair search instead of the intra-object one), every other answer must
+  // be the full run's, and nothing of the intra-object part may be written.
   ScratchDir dir;
-  const fs::path scene = fs::path(VPROXQ_SAMPLE_SCENES_DIR) / "bowl-tiny" / "scene.json";
+  const fs::path scene = fs::path(VPROXQ_TEST_DATA_DIR) / "folded-letters" / "scene.json";
   const std::string common = quote(scene) + " --queries=distance,pd --threads 2 --quiet -o ";
   const auto on = vproxq(common + quote(dir / "on"));
   ASSERT_EQ(on.exit_code, 0) << on.output;

@@ -114,12 +114,13 @@ TEST(PdTwoCubes, CliWritesPairsAndDepth) {
 }
 
 TEST(PdSelf, CliWritesTheReasonOfEachSelfIntersectionEntry) {
-  // The tiny bowl scene (sample_scenes/bowl-tiny, soft letters in a bowl): its self entries
-  // with and without a number. Each entry of the JSON and HDF5 output is the core's for the
-  // frame, with "reason" (and HDF5's reason, reason_a, reason_b) on self_intersection entries
-  // only, and each reason holds (tests/support/pd_checks.hpp).
+  // Soft letters in a bowl whose "g" folds through itself (tests/data/folded-letters, the tiny
+  // bowl scene as the generator wrote it up to a00fc26): its self entries with and without a
+  // number. Each entry of the JSON and HDF5 output is the core's for the frame, with "reason"
+  // (and HDF5's reason, reason_a, reason_b) on self_intersection entries only, and each reason
+  // holds (tests/support/pd_checks.hpp).
   ScratchDir dir;
-  const fs::path scene = fs::path(VPROXQ_SAMPLE_SCENES_DIR) / "bowl-tiny" / "scene.json";
+  const fs::path scene = fs::path(VPROXQ_TEST_DATA_DIR) / "folded-letters" / "scene.json";
   const auto r = test::vproxq(quote(scene) + " --queries=pd --threads 2 --quiet -o " + quote(dir / "out"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json j = test::read_json(dir / "out" / "results.json");
