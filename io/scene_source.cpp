@@ -241,9 +241,10 @@ class SceneParser {
     std::string why;
     if (!parse_frame_pattern(pattern, fp, why)) fail(key + ".pattern", why + ", got " + shown(pj));
     const long long first = j.contains("first") ? integer(j["first"], key + ".first", 0, INT_MAX,
-                                                          "a non-negative integer")
+                                                          "an integer from 0 to 2147483647")
                                                 : 0;
-    const long long count = integer(j["count"], key + ".count", 1, INT_MAX, "a positive integer");
+    static_assert(INT_MAX == 2147483647, "the messages below name INT_MAX");
+    const long long count = integer(j["count"], key + ".count", 1, INT_MAX, "an integer from 1 to 2147483647");
     if (first + count - 1 > INT_MAX) {
       fail(key + ".count", "is too large: " + in_quotes(key + ".first") + " + " +
                                in_quotes(key + ".count") + " exceeds the largest frame number " +
