@@ -3,6 +3,7 @@
 #include "app/check_ccd.hpp"
 #include "app/config.hpp"
 #include "core/errors.hpp"
+#include "io/output.hpp"
 #include "io/result_diff.hpp"
 #include "io/scene_source.hpp"
 
@@ -80,6 +81,26 @@ std::vector<std::string> parse_query_list(const std::vector<std::string>& values
   return out;
 }
 
+/// `vproxq diff --ignore` values: comma-separated member names, as --queries takes its list (an
+/// empty item is a usage error, not a silent no-op); a name given twice counts once.
+std::vector<std::string> parse_key_list(const std::vector<std::string>& values) {
+  std::vector<std::string> out;
+  for (const std::string& text : values) {
+    std::size_t start = 0;
+    while (true) {
+      const std::size_t comma = text.find(',', start);
+      const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+      if (item.empty())
+        throw UsageError("--ignore '" + text + "': " + (text.empty() ? "no key given" : "an empty item") +
+                         "; expected comma-separated member names");
+      if (std::find(out.begin(), out.end(), item) == out.end()) out.push_back(item);
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+  }
+  return out;
+}
+
 /// An option value that must be a whole number in [lo, hi]: the message names the range and
 /// the value given (CLI11's own range checks print the type's limits, e.g. DBL_MAX in full).
 CLI::Validator whole_number(long lo, long hi, const std::string& meaning) {
@@ -116,7 +137,10 @@ CLI::Validator tolerance() {
 constexpr long kMaxThreads = 1024;
 
 int report(const char* kind, const std::exception& e, int code) {
-  std::fprintf(stderr, "vproxq: %s: %s\n", kind, e.what());
+  // A message may quote bytes of an input file (a line of a mesh, a scene's text): shown as
+  // valid UTF-8, as `diff` shows a parser's message and the result files write names, so that
+  // stray bytes of a binary or Latin-1 file cannot garble the terminal.
+  std::fprintf(stderr, "vproxq: %s: %s\n", kind, valid_utf8(e.what()).c_str());
   return code;
 }
 
@@ -201,22 +225,23 @@ int diff_main(int argc, char** argv) {
       ->check(tolerance());
   app.add_option("--atol", opts.atol, "absolute tolerance for numbers (default 0)")
       ->check(tolerance());
-  app.add_option("--ignore", opts.ignore,
+  std::vector<std::string> ignore;
+  app.add_option("--ignore", ignore,
                  "a member name to leave out wherever it occurs, e.g. a key added in a later version "
-                 "(repeatable; comma-separated lists too)")
-      ->delimiter(',')
-      ->check(CLI::Validator(
-          [](std::string& key) { return key.empty() ? std::string("an empty key name") : std::string(); },
-          "KEY", "non-empty"));
+                 "(repeatable; comma-separated lists too)");
   app.set_version_flag("--version", std::string("vproxq ") + VPROXQ_VERSION);
   bool done = false;
   const int code = parse_or_exit(app, argc, argv, done);
   if (done) return code;
   return guarded([&] {
+    opts.ignore = parse_key_list(ignore);
     const DiffOutcome out = diff_result_files(a, b, opts);
     if (out.equal) {
-      std::string ignored = "stats, version, settings";
-      for (const std::string& key : opts.ignore) ignored += ", " + key;
+      std::vector<std::string> listed = {"stats", "version", "settings"};
+      for (const std::string& key : opts.ignore)
+        if (std::find(listed.begin(), listed.end(), key) == listed.end()) listed.push_back(key);
+      std::string ignored;
+      for (const std::string& key : listed) ignored += (ignored.empty() ? "" : ", ") + key;
       std::printf("identical (ignoring %s)\n", ignored.c_str());
       return exit_code::kOk;
     }

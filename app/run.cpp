@@ -281,8 +281,17 @@ void run(const Config& config) {
   info.threads = resolve_threads(config.threads);
   const bool self = config.self.value_or(scene.self().value_or(true));
   info.self = self;
-  if (config.self == false && !want_distance && !config.quiet)
-    std::fprintf(stderr, "vproxq: note: --self has no effect without the distance query\n");
+  // Options that no query of the run uses: said once, like the backend's in cli.cpp (which
+  // notes --grid and --ccd-grid with --voronoi=off; here only with a backend, so as not to say
+  // it twice).
+  if (!config.quiet) {
+    if (config.self.has_value() && !want_distance)
+      std::fprintf(stderr, "vproxq: note: --self has no effect without the distance query\n");
+    if (config.voronoi != "off" && config.grid > 0 && !want_distance)
+      std::fprintf(stderr, "vproxq: note: --grid has no effect without the distance query\n");
+    if (config.voronoi != "off" && config.ccd_grid > 0 && !want_ccd)
+      std::fprintf(stderr, "vproxq: note: --ccd-grid has no effect without the ccd query\n");
+  }
   info.frame_count = static_cast<std::size_t>(last - first);
   const int grid = config.grid > 0 ? config.grid : scene.grid().value_or(0);
   VoronoiStage voronoi = make_voronoi_stage(config, info.threads);

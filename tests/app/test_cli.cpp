@@ -93,6 +93,28 @@ TEST(Cli, OptionsTheBackendDoesNotUseAreNoted) {
   EXPECT_EQ(r.output.find("note:"), std::string::npos) << r.output;
   r = vproxq(scene + " --grid 64 --quiet");
   EXPECT_EQ(r.output.find("note:"), std::string::npos) << r.output;
+  // With a backend, options that no query of the run reads are noted too.
+  r = vproxq(scene + " --grid 64 --voronoi=cpu --queries=pd");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("note: --grid has no effect without the distance query"), std::string::npos) << r.output;
+  r = vproxq(scene + " --ccd-grid 8 --voronoi=cpu --queries=distance");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("note: --ccd-grid has no effect without the ccd query"), std::string::npos) << r.output;
+  r = vproxq(scene + " --grid 64 --ccd-grid 8 --voronoi=cpu --queries=distance,ccd");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("note:"), std::string::npos) << r.output;
+}
+
+// Error messages quote bytes of the input as valid UTF-8: a Latin-1 byte of a mesh file shows as
+// U+FFFD, never raw.
+TEST(Cli, ErrorMessagesShowInputBytesAsValidUtf8) {
+  ScratchDir dir;
+  const auto mesh = dir.write("latin1.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\ncaf\xe9 1 2 3\nf 1 2 3\n");
+  const auto r = vproxq(quote(mesh));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("latin1.obj"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("caf\xef\xbf\xbd"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find('\xe9'), std::string::npos) << r.output;
 }
 
 TEST(Cli, UsageErrors) {
@@ -680,6 +702,16 @@ TEST(Cli, RepeatedRunsAreIdenticalAndDiffDetectsChanges) {
   EXPECT_EQ(r.exit_code, 1) << r.output;
   r = vproxq("diff " + quote(a) + " " + quote(dir / "c.json") + " --ignore=");
   EXPECT_EQ(r.exit_code, 2) << r.output;
+  // An empty item is a usage error, as in --queries; a name given twice (or one always left
+  // out) is listed once.
+  for (const char* bad : {"--ignore inter,,intra", "--ignore inter,", "--ignore ,inter", "--ignore ''"}) {
+    r = vproxq("diff " + quote(a) + " " + quote(dir / "c.json") + " " + bad);
+    EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.output;
+    EXPECT_NE(r.output.find("usage error: --ignore"), std::string::npos) << bad << ": " << r.output;
+  }
+  r = vproxq("diff " + quote(a) + " " + quote(dir / "c.json") + " --ignore inter,stats --ignore inter");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("identical (ignoring stats, version, settings, inter)\n"), std::string::npos) << r.output;
   // A subnormal tolerance is a finite number >= 0 too (accepted, and far too small here).
   r = vproxq("diff " + quote(a) + " " + quote(dir / "c.json") + " --atol=1e-310");
   EXPECT_EQ(r.exit_code, 1) << r.output;

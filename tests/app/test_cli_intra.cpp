@@ -245,6 +245,9 @@ TEST(CliIntra, SelfOffLeavesOutTheIntraObjectPartAlone) {
   const auto note = vproxq(quote(scene) + " --queries=pd --frames 0:1 --self off");
   EXPECT_EQ(note.exit_code, 0) << note.output;
   EXPECT_NE(note.output.find("--self has no effect without the distance query"), std::string::npos) << note.output;
+  const auto note_on = vproxq(quote(scene) + " --queries=pd --frames 0:1 --self on");
+  EXPECT_EQ(note_on.exit_code, 0) << note_on.output;
+  EXPECT_NE(note_on.output.find("--self has no effect without the distance query"), std::string::npos) << note_on.output;
   const auto bad = vproxq(quote(scene) + " --self maybe -o " + quote(dir / "bad"));
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
   EXPECT_FALSE(fs::exists(dir / "bad"));
