@@ -207,7 +207,16 @@ int parse_or_exit(CLI::App& app, int argc, char** argv, bool& done) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     done = true;
-    std::fprintf(stderr, "vproxq: usage error: %s\nRun with --help for the options.\n", e.what());
+    // CLI11 says "--grid: At Most 1 required but received 2" for an option of one value given
+    // more than once.
+    const std::string message = e.what();
+    const std::string at_most = ": At Most 1 required but received ";
+    const std::size_t at = message.find(at_most);
+    if (at != std::string::npos && at > 0)
+      std::fprintf(stderr, "vproxq: usage error: %s is given %s times; it takes one value\nRun with --help for the options.\n",
+                   message.substr(0, at).c_str(), message.substr(at + at_most.size()).c_str());
+    else
+      std::fprintf(stderr, "vproxq: usage error: %s\nRun with --help for the options.\n", message.c_str());
     return exit_code::kUsage;
   }
   return 0;

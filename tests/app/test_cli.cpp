@@ -138,7 +138,11 @@ TEST(Cli, UsageErrors) {
            {scene + " --frames= -q", "--frames has no value"},
            // -o=OUT would write into a directory named "=OUT".
            {scene + " -o=out -q", "-o=out: write -o out or --output=out"},
-           {scene + " -o= -q", "-o= has no value: write -o OUT, -oOUT or --output=OUT"}}) {
+           {scene + " -o= -q", "-o= has no value: write -o OUT, -oOUT or --output=OUT"},
+           // An option of one value given more than once (CLI11: "At Most 1 required").
+           {scene + " --grid 8 --grid 9 -q", "--grid is given 2 times; it takes one value"},
+           {scene + " --threads 1 --threads 2 --threads 1 -q", "--threads is given 3 times; it takes one value"},
+           {"diff a.json b.json --rtol 1 --rtol 2", "--rtol is given 2 times; it takes one value"}}) {
     SCOPED_TRACE(args);
     r = vproxq(args);
     EXPECT_EQ(r.exit_code, 2) << r.output;
