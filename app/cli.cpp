@@ -59,9 +59,11 @@ FrameRange parse_frame_range(const std::string& text) {
   return r;
 }
 
-/// Splits --queries' comma-separated value. Empty items and repeats are usage errors, as
-/// repeats are in scene.json's "queries"; unknown names are checked with the scene's list.
-std::vector<std::string> parse_query_list(const std::vector<std::string>& values) {
+/// The items of the comma-separated values of a list option (--queries, diff --ignore), in
+/// order. An empty item (`a,,b`) or value is a usage error, not a silent no-op: `noun` names
+/// what a value lists, `expected` what its items may be.
+std::vector<std::string> list_items(const std::vector<std::string>& values, const std::string& option,
+                                    const std::string& noun, const std::string& expected) {
   std::vector<std::string> out;
   for (const std::string& text : values) {
     std::size_t start = 0;
@@ -69,10 +71,8 @@ std::vector<std::string> parse_query_list(const std::vector<std::string>& values
       const std::size_t comma = text.find(',', start);
       const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
       if (item.empty())
-        throw UsageError("--queries '" + text + "': " + (text.empty() ? "no query given" : "an empty item") +
-                         "; expected comma-separated names from: " + query_names_list());
-      if (std::find(out.begin(), out.end(), item) != out.end())
-        throw UsageError("--queries: '" + item + "' is given twice");
+        throw UsageError(option + " '" + text + "': " + (text.empty() ? "no " + noun + " given" : "an empty item") +
+                         "; expected " + expected);
       out.push_back(item);
       if (comma == std::string::npos) break;
       start = comma + 1;
@@ -81,23 +81,21 @@ std::vector<std::string> parse_query_list(const std::vector<std::string>& values
   return out;
 }
 
-/// `vproxq diff --ignore` values: comma-separated member names, as --queries takes its list (an
-/// empty item is a usage error, not a silent no-op); a name given twice counts once.
+/// --queries' names. Repeats are usage errors, as they are in scene.json's "queries"; unknown
+/// names are checked with the scene's list.
+std::vector<std::string> parse_query_list(const std::vector<std::string>& values) {
+  const std::vector<std::string> items =
+      list_items(values, "--queries", "query", "comma-separated names from: " + query_names_list());
+  for (auto it = items.begin(); it != items.end(); ++it)
+    if (std::find(items.begin(), it, *it) != it) throw UsageError("--queries: '" + *it + "' is given twice");
+  return items;
+}
+
+/// `vproxq diff --ignore`'s member names; a name given twice counts once.
 std::vector<std::string> parse_key_list(const std::vector<std::string>& values) {
   std::vector<std::string> out;
-  for (const std::string& text : values) {
-    std::size_t start = 0;
-    while (true) {
-      const std::size_t comma = text.find(',', start);
-      const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-      if (item.empty())
-        throw UsageError("--ignore '" + text + "': " + (text.empty() ? "no key given" : "an empty item") +
-                         "; expected comma-separated member names");
-      if (std::find(out.begin(), out.end(), item) == out.end()) out.push_back(item);
-      if (comma == std::string::npos) break;
-      start = comma + 1;
-    }
-  }
+  for (const std::string& item : list_items(values, "--ignore", "key", "comma-separated member names"))
+    if (std::find(out.begin(), out.end(), item) == out.end()) out.push_back(item);
   return out;
 }
 
