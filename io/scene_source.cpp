@@ -182,12 +182,12 @@ class SceneParser {
   }
 
   long long integer(const json& v, const std::string& key, long long min, long long max,
-                    const char* what) const {
+                    const std::string& what) const {
     const bool ok = v.is_number_integer() &&
                     (!v.is_number_unsigned() ||
                      v.get<unsigned long long>() <= static_cast<unsigned long long>(max)) &&
                     v.get<long long>() >= min && v.get<long long>() <= max;
-    if (!ok) fail(key, std::string("must be ") + what + ", got " + shown(v));
+    if (!ok) fail(key, "must be " + what + ", got " + shown(v));
     return v.get<long long>();
   }
 
@@ -240,11 +240,11 @@ class SceneParser {
     FramePattern fp;
     std::string why;
     if (!parse_frame_pattern(pattern, fp, why)) fail(key + ".pattern", why + ", got " + shown(pj));
+    const std::string largest = std::to_string(INT_MAX);
     const long long first = j.contains("first") ? integer(j["first"], key + ".first", 0, INT_MAX,
-                                                          "an integer from 0 to 2147483647")
+                                                          "an integer from 0 to " + largest)
                                                 : 0;
-    static_assert(INT_MAX == 2147483647, "the messages below name INT_MAX");
-    const long long count = integer(j["count"], key + ".count", 1, INT_MAX, "an integer from 1 to 2147483647");
+    const long long count = integer(j["count"], key + ".count", 1, INT_MAX, "an integer from 1 to " + largest);
     if (first + count - 1 > INT_MAX) {
       fail(key + ".count", "is too large: " + in_quotes(key + ".first") + " + " +
                                in_quotes(key + ".count") + " exceeds the largest frame number " +
@@ -427,7 +427,7 @@ void parse_scene_json(SceneImpl& s) {
   }
   if (root.contains("grid")) {
     const std::string what = "an integer in [1, " + std::to_string(kMaxGridResolution) + "]";
-    s.grid = static_cast<int>(p.integer(root["grid"], "grid", 1, kMaxGridResolution, what.c_str()));
+    s.grid = static_cast<int>(p.integer(root["grid"], "grid", 1, kMaxGridResolution, what));
   }
   if (root.contains("self")) {
     if (!root["self"].is_boolean()) p.fail("self", "must be true or false, got " + shown(root["self"]));
