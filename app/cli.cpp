@@ -235,7 +235,8 @@ int diff_main(int argc, char** argv) {
   std::vector<std::string> ignore;
   app.add_option("--ignore", ignore,
                  "a member name to leave out wherever it occurs, e.g. a key added in a later version "
-                 "(repeatable; comma-separated lists too)");
+                 "(repeatable; comma-separated lists too)")
+      ->option_text("KEY[,KEY...]");
   app.set_version_flag("--version", std::string("vproxq ") + VPROXQ_VERSION);
   bool done = false;
   const int code = parse_or_exit(app, argc, argv, done);
@@ -297,7 +298,8 @@ int cli_main(int argc, char** argv) {
   app.add_option("--queries", queries,
                  "comma-separated queries to run (default: the scene's \"queries\", else "
                  "distance). Valid: " + query_names_list())
-      ->allow_extra_args(false);
+      ->allow_extra_args(false)
+      ->option_text("Q[,Q...]");
   app.add_option("-o,--output", config.output_dir,
                  "write OUT/results.json and OUT/results.h5 (default: print a summary)")
       ->check([](const std::string& dir) { return dir.empty() ? std::string("the output directory must not be empty") : std::string(); });
