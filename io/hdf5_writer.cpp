@@ -53,6 +53,8 @@ struct PdRow {  // one object pair's penetration depth
 
 struct FeatureRow {  // one overlapping feature of one pd row
   std::int32_t pair, object, id;
+  std::uint8_t side;  // which of the entry's two lists (objects[side]): a self entry's two
+                      // lists are of one object, the deepest vertex's piece of sheet and the rest
 };
 
 // One row of distance/intra: triangle `triangle` of object `object` and its nearest
@@ -267,10 +269,12 @@ struct Hdf5ResultWriter::Impl {
                     i32("reason_a", offsetof(PdRow, reason_a)), i32("reason_b", offsetof(PdRow, reason_b))},
                    sizeof(PdRow), pd_mem_type, pd_file_type);
     build_compound({i32("pair", offsetof(FeatureRow, pair)), i32("object", offsetof(FeatureRow, object)),
-                    i32("vertex", offsetof(FeatureRow, id))},
+                    i32("vertex", offsetof(FeatureRow, id)),
+                    {"side", offsetof(FeatureRow, side), H5T_NATIVE_UINT8, H5T_STD_U8LE}},
                    sizeof(FeatureRow), vertex_feature_mem_type, vertex_feature_file_type);
     build_compound({i32("pair", offsetof(FeatureRow, pair)), i32("object", offsetof(FeatureRow, object)),
-                    i32("triangle", offsetof(FeatureRow, id))},
+                    i32("triangle", offsetof(FeatureRow, id)),
+                    {"side", offsetof(FeatureRow, side), H5T_NATIVE_UINT8, H5T_STD_U8LE}},
                    sizeof(FeatureRow), triangle_feature_mem_type, triangle_feature_file_type);
   }
 
@@ -309,8 +313,9 @@ struct Hdf5ResultWriter::Impl {
       rows.push_back(row);
       const auto pair = static_cast<std::int32_t>(k);
       for (std::size_t side = 0; side < 2; ++side) {
-        for (Index v : p.inside_vertices[side]) vertices.push_back({pair, p.objects[side], v});
-        for (Index t : p.overlapping_triangles[side]) triangles.push_back({pair, p.objects[side], t});
+        const auto s8 = static_cast<std::uint8_t>(side);
+        for (Index v : p.inside_vertices[side]) vertices.push_back({pair, p.objects[side], v, s8});
+        for (Index t : p.overlapping_triangles[side]) triangles.push_back({pair, p.objects[side], t, s8});
       }
     }
     const std::string pd_where = where + "/pd";

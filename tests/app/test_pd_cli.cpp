@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <fstream>
 #include <map>
 
@@ -24,6 +25,26 @@ using test::ScratchDir;
 
 const fs::path kMeshes = fs::path(VPROXQ_TEST_DATA_DIR) / "meshes";
 const char* const kTwoCubes[] = {"two-cubes-far.ply", "two-cubes-close.ply", "two-cubes-intersecting.ply"};
+
+/// The rows of `group`/pd/inside_vertices and pd/overlapping_triangles are, in order, each
+/// entry's features of side 0 then of side 1: {pair, objects[side], feature, side}.
+void expect_pd_features(const Hdf5Reader& h5, const std::string& group, const std::vector<PenetrationDepth>& pd) {
+  using Row = std::array<std::int64_t, 4>;
+  for (const bool vertices : {true, false}) {
+    const std::string ds = group + (vertices ? "/pd/inside_vertices" : "/pd/overlapping_triangles");
+    SCOPED_TRACE(ds);
+    std::vector<Row> expected;
+    for (size_t p = 0; p < pd.size(); ++p)
+      for (int side = 0; side < 2; ++side)
+        for (Index f : vertices ? pd[p].inside_vertices[side] : pd[p].overlapping_triangles[side])
+          expected.push_back({static_cast<std::int64_t>(p), pd[p].objects[side], f, side});
+    const auto pair = h5.int_field(ds, "pair"), object = h5.int_field(ds, "object"),
+               id = h5.int_field(ds, vertices ? "vertex" : "triangle"), side = h5.int_field(ds, "side");
+    std::vector<Row> written;
+    for (size_t r = 0; r < pair.size(); ++r) written.push_back({pair[r], object[r], id[r], side[r]});
+    EXPECT_EQ(written, expected);
+  }
+}
 
 /// One frame with one object per connected component of the file.
 Frame load_components(const fs::path& file) {
@@ -107,9 +128,8 @@ TEST(PdTwoCubes, CliWritesPairsAndDepth) {
       for (int c = 0; c < 3; ++c) EXPECT_EQ(fj["pd"][p]["direction"][c].get<double>(), pd[p].direction[c]);
       EXPECT_EQ(h5.double_field(group + "/pd/pairs", "depth")[p], pd[p].depth);
       EXPECT_EQ(h5.int_field(group + "/pd/pairs", "status")[p], 0);
-      const auto verts = h5.int_field(group + "/pd/inside_vertices", "vertex");
-      EXPECT_EQ(verts.size(), pd[p].inside_vertices[0].size() + pd[p].inside_vertices[1].size());
     }
+    expect_pd_features(h5, group, pd);
   }
 }
 
@@ -149,6 +169,8 @@ TEST(PdSelf, CliWritesTheReasonOfEachSelfIntersectionEntry) {
       EXPECT_EQ(rb[p], pd[p].reason_features[1]);
       ++seen[undecided ? pd_reason_name(pd[p].reason) : pd_status_name(pd[p].status)];
     }
+    // A self entry's two lists, one object's, told apart by `side` only.
+    expect_pd_features(h5, "/frames/00000" + std::to_string(k), pd);
   }
   // What the scene holds (README, "Where it gives no number"): a number on three frames, one
   // pair of sheets the curve does not separate; the independent PD oracle (written from the
