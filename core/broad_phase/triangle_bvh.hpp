@@ -55,9 +55,19 @@ class TriangleBvh {
   std::vector<AABB> node_unions(const std::vector<AABB>& boxes) const;
 
   /// Calls visit(t) for every triangle t whose box overlaps `query` (closed boxes), without
-  /// entering a subtree for which skip(node index) is true.
+  /// entering a subtree for which skip(node index) is true; in the subtree of node `from`
+  /// (the root by default) only.
   template <typename Skip, typename Visit>
-  void query_overlaps(const AABB& query, const Skip& skip, const Visit& visit) const;
+  void query_overlaps(const AABB& query, const Skip& skip, const Visit& visit, std::int32_t from = 0) const;
+
+  /// Whether a node (an index as skip() receives) is a leaf.
+  bool is_leaf(std::int32_t node) const { return nodes_[static_cast<size_t>(node)].count > 0; }
+  /// Calls visit(t) for the triangles of a leaf, in their order in the hierarchy.
+  template <typename Visit>
+  void for_each_leaf_triangle(std::int32_t leaf, const Visit& visit) const {
+    const Node& node = nodes_[static_cast<size_t>(leaf)];
+    for (std::int32_t k = node.first; k < node.first + node.count; ++k) visit(order_[static_cast<size_t>(k)]);
+  }
 
   /// A pair of nodes of one hierarchy: the same node (the pairs within its subtree), or two
   /// nodes neither of which lies in the other's subtree (the pairs across them).
@@ -86,6 +96,17 @@ class TriangleBvh {
   /// included), whatever their boxes.
   template <typename Enter, typename Visit>
   void descend_self(const NodePair& start, const Enter& enter, const Visit& visit) const;
+  /// The descent of descend_self() from `start`, entering a pair (x, y) only where enter(x, y)
+  /// is true, that hands each entered pair to take(x, y) and splits it as descend_self() does
+  /// unless take() returns true (it has dealt with the pair's triangle pairs). take() must
+  /// return true for a pair with a leaf in it (a leaf with itself included): those are not
+  /// split.
+  template <typename Enter, typename Take>
+  void descend_self_until(const NodePair& start, const Enter& enter, const Take& take) const {
+    if (nodes_.empty()) return;
+    thread_local std::vector<NodePair> stack;  // reused: called per unit of work
+    walk_self(start, stack, enter, [&](std::int32_t a, std::int32_t b, const Node&, const Node&) { return take(a, b); });
+  }
   /// self_overlap_pairs() for descend_self() with `enter`: running descend_self() with the
   /// same enter on each pair returned visits what it visits from the root.
   template <typename Enter>
@@ -246,11 +267,11 @@ void TriangleBvh::query(const AABB& q, const Bound& bound, const Visit& visit, c
 }
 
 template <typename Skip, typename Visit>
-void TriangleBvh::query_overlaps(const AABB& q, const Skip& skip, const Visit& visit) const {
+void TriangleBvh::query_overlaps(const AABB& q, const Skip& skip, const Visit& visit, std::int32_t from) const {
   if (nodes_.empty()) return;
   std::int32_t stack[64];
   int top = 0;
-  stack[top++] = 0;
+  stack[top++] = from;
   while (top > 0) {
     const std::int32_t at = stack[--top];
     const Node& node = nodes_[static_cast<size_t>(at)];
