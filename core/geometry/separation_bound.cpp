@@ -3,34 +3,71 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace vproxq {
 namespace {
 
 constexpr double kMinAxisSquared = 0x1p-900;
 
-/// The gap between the projections of a and b onto w, divided by |w| (see the header).
-/// Swapping a and b, or negating w, gives bitwise the same value.
-double axis_gap(const Triangle& a, const Triangle& b, const Vec3& w) {
-  const double ww = w.squaredNorm();
-  if (!(ww >= kMinAxisSquared) || !std::isfinite(ww)) return -kInfinity;
-  const ProjectionGaps g = projection_gaps(a, b, w);
-  const double gap = std::max(g.b_above_a, g.a_above_b) / std::sqrt(ww);
+/// Whether an axis w with w . w = ww proves anything: skipped below 2^-900 (underflow) and
+/// when not finite (see the header).
+bool usable_axis(double ww) { return ww >= kMinAxisSquared && std::isfinite(ww); }
+
+/// gap / |w| for the projection gaps g of a and b onto w, |w| = `norm`.
+double axis_gap(const ProjectionGaps& g, double norm) {
+  const double gap = std::max(g.b_above_a, g.a_above_b) / norm;
   // Coordinates beyond ~2^300 can overflow a projection: such an axis proves nothing.
   return std::isfinite(gap) ? gap : -kInfinity;
 }
 
+/// The gap along site s's normal between its own triangle (projections s.lo..s.hi) and t:
+/// axis_gap(projection_gaps(a, b, s.normal)) whichever of a and b the site's triangle is.
+/// The two differences only trade places, and their max is the same either way: one is NaN
+/// (infinities of one sign on both sides) only where the other is not finite either, and
+/// axis_gap() returns -infinity for both.
+double normal_gap(const SeparationSite& s, const Triangle& t) {
+  if (std::isnan(s.normal_norm)) return -kInfinity;
+  double lo = kInfinity, hi = -kInfinity;
+  for (size_t k = 0; k < 3; ++k) {
+    const double p = s.normal.dot(t[k]);
+    lo = p < lo ? p : lo;
+    hi = p > hi ? p : hi;
+  }
+  return axis_gap({lo - s.hi, s.lo - hi}, s.normal_norm);
+}
+
 }  // namespace
 
-double separation_lower_bound(const Triangle& a, const Triangle& b) {
+SeparationSite separation_site(const Triangle& t) {
+  SeparationSite s;
+  s.normal = (t[1] - t[0]).cross(t[2] - t[0]);
+  const double ww = s.normal.squaredNorm();
+  s.normal_norm = usable_axis(ww) ? std::sqrt(ww) : std::numeric_limits<double>::quiet_NaN();
+  s.lo = kInfinity;
+  s.hi = -kInfinity;
+  for (size_t k = 0; k < 3; ++k) {
+    const double p = s.normal.dot(t[k]);
+    s.lo = p < s.lo ? p : s.lo;
+    s.hi = p > s.hi ? p : s.hi;
+  }
+  s.sum = t[0] + t[1] + t[2];
+  return s;
+}
+
+double separation_lower_bound(const Triangle& a, const SeparationSite& sa, const Triangle& b, const SeparationSite& sb) {
   // Centroid line: the sums are formed in corner order for each triangle, so swapping a and
-  // b negates the axis exactly.
-  const Vec3 centres = (b[0] + b[1] + b[2]) - (a[0] + a[1] + a[2]);
-  const double g0 = axis_gap(a, b, (a[1] - a[0]).cross(a[2] - a[0]));
-  const double g1 = axis_gap(a, b, (b[1] - b[0]).cross(b[2] - b[0]));
+  // b negates the axis exactly (and the gap, the larger of the two differences, is the same).
+  const Vec3 centres = sb.sum - sa.sum;
+  const double ww = centres.squaredNorm();
+  const double g2 = usable_axis(ww) ? axis_gap(projection_gaps(a, b, centres), std::sqrt(ww)) : -kInfinity;
   // The larger of a's and b's normal gaps first, in an order that does not depend on which
   // triangle is a, so the result is symmetric.
-  return std::max(std::max(g0, g1), axis_gap(a, b, centres));
+  return std::max(std::max(normal_gap(sa, b), normal_gap(sb, a)), g2);
+}
+
+double separation_lower_bound(const Triangle& a, const Triangle& b) {
+  return separation_lower_bound(a, separation_site(a), b, separation_site(b));
 }
 
 }  // namespace vproxq

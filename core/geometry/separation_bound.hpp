@@ -46,4 +46,18 @@ inline ProjectionGaps projection_gaps(const Triangle& a, const Triangle& b, cons
 /// Symmetric: separation_lower_bound(a, b) == separation_lower_bound(b, a), bitwise.
 double separation_lower_bound(const Triangle& a, const Triangle& b);
 
+/// The part of separation_lower_bound() that depends on one triangle alone: its normal axis
+/// (and the projections of its own corners onto it) and the sum of its corners. A search that
+/// meets each triangle in many pairs computes it once per triangle.
+struct SeparationSite {
+  Vec3 normal;            ///< (t1 - t0) x (t2 - t0)
+  double normal_norm;     ///< sqrt(normal . normal); NaN when the axis is skipped (see .cpp)
+  double lo, hi;          ///< the smallest and largest of normal . t_k
+  Vec3 sum;               ///< t0 + t1 + t2
+};
+SeparationSite separation_site(const Triangle& t);
+
+/// separation_lower_bound(a, b), bitwise, from a's and b's sites (separation_site()).
+double separation_lower_bound(const Triangle& a, const SeparationSite& sa, const Triangle& b, const SeparationSite& sb);
+
 }  // namespace vproxq

@@ -183,13 +183,16 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     if (!marked(opts.skip, i)) out.per_object[i].per_triangle.assign(static_cast<size_t>(frame.objects[i].num_triangles()), {});
   }
   // Per object of at least 2 triangles, what its search reads: the records, each triangle's
-  // D_u, the common vertices of each node's triangles, and per node the largest reach of its
-  // triangles (D_u plus the rounding slack) and, with Stage II, their smallest D_l.
+  // D_u, the common vertices of each node's triangles, per node the largest reach of its
+  // triangles (D_u plus the rounding slack) and, with Stage II, their smallest D_l; and each
+  // triangle's part of the separation bound (SeparationSite), computed once instead of in
+  // each of its candidate pairs (README, "Exactness").
   struct ObjectSearch {
     std::unique_ptr<SharedPairs> pairs;
     std::vector<double> upper;
     std::vector<std::array<Index, 3>> common;
     std::vector<double> reach, node_lower;
+    std::vector<SeparationSite> sites;  ///< per triangle: its part of separation_lower_bound()
     double slack = 0;
   };
   std::vector<ObjectSearch> search(n_obj);
@@ -227,6 +230,8 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     s.slack = rounding_slack(boxes.magnitudes[i]);
     s.pairs = std::make_unique<SharedPairs>(n);
     s.common = bvh.node_common_vertices(frame.objects[i].topology->faces);
+    s.sites.resize(n);
+    for (size_t t = 0; t < n; ++t) s.sites[t] = separation_site(frame.objects[i].triangle(static_cast<Index>(t)));
     // D_u(t): the 2-ring bound, or Stage II's (which already includes it) when smaller.
     s.upper = ring2_bound[i];
     if (voronoi)
@@ -260,6 +265,7 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     const double* lower = voronoi ? voronoi->triangle_lower[i].data() : nullptr;
     DistanceCounters& c = counters[k];
     const double* upper = s.upper.data();
+    const SeparationSite* sites = s.sites.data();
     const auto bound = [&](size_t t) { return std::min(upper[t], pairs.current(t)) + s.slack; };
     // The candidate pair (f, g), f < g, whose boxes are d2 apart (squared).
     auto try_pair = [&](Index f, Index g, double d2) {
@@ -280,7 +286,8 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
         if (!for_f && !for_g) return;
       }
       // Boxes within the bound, triangles provably farther apart (separation_bound.hpp).
-      const double separation = separation_lower_bound(o.triangle(f), o.triangle(g));
+      const double separation = separation_lower_bound(o.triangle(f), sites[static_cast<size_t>(f)], o.triangle(g),
+                                                       sites[static_cast<size_t>(g)]);
       if (for_f && separation > bf) {
         for_f = false;
         ++c.intra_separation_culled;

@@ -786,10 +786,30 @@ TEST(TriangleDistance, AdversarialShapesMatchTwin) {
 
 // ---- separation lower bound ----------------------------------------------------------------
 
-/// separation_lower_bound(a, b) is symmetric bitwise and never above the twin's distance by
-/// more than its documented rounding bound 2^-48 S. Returns whether it is positive.
+/// The separation bound computed pair by pair as its header states it, every axis from the
+/// two triangles' corners: the twin of separation_lower_bound(), which takes each triangle's
+/// own part from a SeparationSite computed once per triangle.
+double twin_separation(const Triangle& a, const Triangle& b) {
+  auto gap = [&](const Vec3& w) {
+    const double ww = w.squaredNorm();
+    if (!(ww >= 0x1p-900) || !std::isfinite(ww)) return -kInfinity;
+    const ProjectionGaps g = projection_gaps(a, b, w);
+    const double q = std::max(g.b_above_a, g.a_above_b) / std::sqrt(ww);
+    return std::isfinite(q) ? q : -kInfinity;
+  };
+  const Vec3 centres = (b[0] + b[1] + b[2]) - (a[0] + a[1] + a[2]);
+  const double g0 = gap((a[1] - a[0]).cross(a[2] - a[0]));
+  const double g1 = gap((b[1] - b[0]).cross(b[2] - b[0]));
+  return std::max(std::max(g0, g1), gap(centres));
+}
+
+/// separation_lower_bound(a, b) is its twin's value bitwise, symmetric bitwise, and never
+/// above the twin distance by more than its documented rounding bound 2^-48 S. Returns
+/// whether it is positive.
 bool check_separation(const Triangle& a, const Triangle& b) {
   const double lb = separation_lower_bound(a, b), lb_swapped = separation_lower_bound(b, a);
+  const double lb_twin = twin_separation(a, b);
+  EXPECT_EQ(std::memcmp(&lb, &lb_twin, sizeof lb), 0) << "not the twin's value: " << lb << " vs " << lb_twin;
   EXPECT_EQ(std::memcmp(&lb, &lb_swapped, sizeof lb), 0) << "not symmetric";
   const Real twin = twin_hull_distance(as_points(a), as_points(b)).distance;
   EXPECT_LE(static_cast<Real>(lb), twin + static_cast<Real>(0x1p-48 * scale_of(a, b)))
@@ -835,6 +855,33 @@ TEST(SeparationBound, NeverAboveTheTwinDistance) {
   }
 }
 
+TEST(SeparationBound, SitesGiveThePairsValueAtEveryScale) {
+  // From 2^-1000 to 2^1000, near the origin and up to 2^1020 from it (overflowing axes and
+  // projections, underflowing axes, subnormal coordinates): the value from the per-triangle sites is the pair-by-pair twin's, bitwise,
+  // whichever triangle comes first.
+  std::mt19937_64 rng(34);
+  std::uniform_real_distribution<double> unit01(0.0, 1.0);
+  int positive = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    const double scale = std::ldexp(1.0, static_cast<int>(2000 * unit01(rng)) - 1000);
+    Triangle a = random_triangle(rng, Vec3::Zero(), 1.0);
+    Triangle b = random_triangle(rng, random_vec(rng, 1.5), 1.0);
+    if (trial % 4 == 1) b = {a[0] + Vec3(0, 0, 0.5), a[1] + Vec3(0, 0, 0.5), a[2] + Vec3(0, 0, 0.5)};
+    if (trial % 4 == 2) a[2] = a[0];
+    // Every fourth pair far from the origin: small triangles there overflow projections
+    // onto axes that themselves stay finite.
+    const Vec3 far = trial % 4 == 3 ? Vec3(std::ldexp(1.0, static_cast<int>(1020 * unit01(rng))), 0, 0) : Vec3::Zero();
+    for (auto* t : {&a, &b})
+      for (Vec3& p : *t) p = p * scale + far;
+    const double lb = separation_lower_bound(a, b), lb_swapped = separation_lower_bound(b, a);
+    const double twin = twin_separation(a, b);
+    ASSERT_EQ(std::memcmp(&lb, &twin, sizeof lb), 0) << "trial " << trial << ": " << lb << " vs " << twin;
+    ASSERT_EQ(std::memcmp(&lb, &lb_swapped, sizeof lb), 0) << "trial " << trial;
+    positive += lb > 0;
+  }
+  EXPECT_GT(positive, 500);  // not a vacuous comparison
+}
+
 TEST(SeparationBound, TightAlongTheSeparatingDirection) {
   // Parallel triangles h apart along the normal, and triangles h apart along x with faces
   // facing each other: the bound finds (almost) the whole gap.
@@ -855,9 +902,10 @@ TEST(SeparationBound, TightAlongTheSeparatingDirection) {
   const double big = 1e290;
   const Triangle huge{big * a[0], big * a[1], big * a[2]};
   const Triangle huge_up{huge[0] + Vec3(0, 0, big), huge[1] + Vec3(0, 0, big), huge[2] + Vec3(0, 0, big)};
-  const double lb = separation_lower_bound(huge, huge_up);
+  const double lb = separation_lower_bound(huge, huge_up), lb_twin = twin_separation(huge, huge_up);
   EXPECT_FALSE(std::isnan(lb));
   EXPECT_LE(lb, big);
+  EXPECT_EQ(std::memcmp(&lb, &lb_twin, sizeof lb), 0) << lb << " vs " << lb_twin;
 }
 
 TEST(TriangleDistance, KnownFeaturesAndTieOrder) {
