@@ -857,8 +857,8 @@ TEST(SeparationBound, NeverAboveTheTwinDistance) {
 
 TEST(SeparationBound, SitesGiveThePairsValueAtEveryScale) {
   // From 2^-1000 to 2^1000, near the origin and up to 2^1020 from it (overflowing axes and
-  // projections, underflowing axes, subnormal coordinates): the value from the per-triangle sites is the pair-by-pair twin's, bitwise,
-  // whichever triangle comes first.
+  // projections, underflowing axes, subnormal coordinates): the value from the per-triangle
+  // sites is the pair-by-pair twin's, bitwise, whichever triangle comes first.
   std::mt19937_64 rng(34);
   std::uniform_real_distribution<double> unit01(0.0, 1.0);
   int positive = 0;
