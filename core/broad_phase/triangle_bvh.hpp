@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <vector>
@@ -157,12 +158,28 @@ class TriangleBvh {
   struct Pending {
     std::int32_t slot, begin, end, next;
   };
-  /// Builds the subtree of triangles order_[begin, end) into node `slot`; its children, if
-  /// any, go to `next` and next + 1, their descendants after them in depth-first order. With
-  /// `pending`, a subtree of at most `grain` triangles is left to be built later (recorded).
+  /// A triangle's place in a split: its centroid coordinate along the split axis, as an
+  /// integer of the same order, then its id.
+  struct SplitKey {
+    std::uint64_t key;
+    std::uint32_t id;
+    /// (key, id) lexicographically, computed without branches.
+    friend bool operator<(const SplitKey& a, const SplitKey& b) {
+      const int below = a.key < b.key, level = a.key == b.key, id_below = a.id < b.id;
+      return (below | (level & id_below)) != 0;
+    }
+  };
+  /// Reorders [first, last) as std::nth_element does (the smallest before `nth`), without
+  /// branching on the comparisons.
+  static void select_nth(SplitKey* first, SplitKey* nth, SplitKey* last);
+  /// What build_node() reads, and the keys it reorders.
+  struct BuildInput;
+  /// Builds the subtree of triangles order_[begin, end) into node `slot` (a leaf gets its box,
+  /// an inner node's comes at the end of build()); its children, if any, go to `next` and
+  /// next + 1, their descendants after them in depth-first order. With `pending`, a subtree of
+  /// at most `grain` triangles is left to be built later (recorded).
   void build_node(std::int32_t slot, std::int32_t begin, std::int32_t end, std::int32_t next,
-                  const std::vector<AABB>& boxes, const std::vector<Vec3>& centroids,
-                  const SubtreeSizes& sizes, std::vector<Pending>* pending, std::int32_t grain);
+                  BuildInput& in, std::vector<Pending>* pending, std::int32_t grain);
   /// Whether a descent of the node pair (na, nb), not two leaves, splits na: the node with
   /// the larger box (the sum of its sides), never a leaf.
   static bool splits_first(const Node& na, const Node& nb) {

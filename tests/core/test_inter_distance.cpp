@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <numeric>
 #include <set>
 #include <tuple>
 
@@ -253,6 +254,79 @@ TEST(TriangleBvh, ParallelBuildGivesTheSameHierarchy) {
       one.query(q, [] { return 0.05; }, [&](Index t, double) { met_one.push_back(t); });
       many.query(q, [] { return 0.05; }, [&](Index t, double) { met_many.push_back(t); });
       EXPECT_EQ(met_many, met_one);
+    }
+  }
+}
+
+/// The documented build, written plainly: node `slot` holds `ids`; above kLeafSize (4) they
+/// split at the median (std::nth_element) along the longest side of their centres' box, by
+/// centre coordinate then id, the children at `next` and next + 1, the left's descendants
+/// after them, then the right's. Records each node's triangles, sorted.
+std::int32_t twin_subtree_nodes(size_t n) { return n <= 4 ? 1 : 1 + twin_subtree_nodes(n / 2) + twin_subtree_nodes(n - n / 2); }
+void twin_build(std::int32_t slot, std::vector<Index> ids, std::int32_t next, const std::vector<AABB>& boxes,
+                std::vector<std::vector<Index>>& sets) {
+  std::vector<Index> sorted = ids;
+  std::sort(sorted.begin(), sorted.end());
+  sets[static_cast<size_t>(slot)] = sorted;
+  if (ids.size() <= 4) return;
+  AABB cb;
+  for (Index t : ids) cb.extend(boxes[static_cast<size_t>(t)].center());
+  const Vec3 ext = cb.hi - cb.lo;
+  int axis = 0;
+  if (ext.y() > ext[axis]) axis = 1;
+  if (ext.z() > ext[axis]) axis = 2;
+  const size_t mid = ids.size() / 2;
+  std::nth_element(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(mid), ids.end(), [&](Index a, Index b) {
+    const double ca = boxes[static_cast<size_t>(a)].center()[axis], cb2 = boxes[static_cast<size_t>(b)].center()[axis];
+    return ca < cb2 || (ca == cb2 && a < b);
+  });
+  const std::vector<Index> left(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(mid));
+  const std::vector<Index> right(ids.begin() + static_cast<std::ptrdiff_t>(mid), ids.end());
+  twin_build(next, left, next + 2, boxes, sets);
+  twin_build(next + 1, right, next + 2 + twin_subtree_nodes(mid) - 1, boxes, sets);
+}
+
+TEST(TriangleBvh, BuildSplitsAtTheMedianAsDocumented) {
+  // Every node holds the triangles the plain median-split build (twin_build) puts there, and
+  // its box is the union of theirs: on a blob's boxes, and on point boxes on a coarse lattice
+  // (many equal centre coordinates, where the id decides; -0 and +0 among them, which are
+  // equal), with one thread and several.
+  const Frame frame = make_random_frame(3, 1, 1.0, 2);
+  const std::vector<AABB> blob = FrameBoxes::compute(frame, 1).triangles[0];
+  std::vector<AABB> lattice;
+  Rng rng(21);
+  const double values[] = {-1.0, -0.0, 0.0, 1.0, 2.0};
+  for (int k = 0; k < 777; ++k) {
+    Vec3 p;
+    for (int d = 0; d < 3; ++d) p[d] = values[rng.integer(0, 4)] * (d + 1);
+    lattice.push_back({p, p});
+  }
+  for (const std::vector<AABB>* boxes : {&blob, static_cast<const std::vector<AABB>*>(&lattice)}) {
+    for (size_t n : {boxes->size(), size_t{9}, size_t{5}, size_t{4}}) {
+      const std::vector<AABB> part(boxes->begin(), boxes->begin() + static_cast<std::ptrdiff_t>(n));
+      std::vector<std::vector<Index>> want(static_cast<size_t>(twin_subtree_nodes(n)));
+      std::vector<Index> ids(n);
+      std::iota(ids.begin(), ids.end(), 0);
+      twin_build(0, ids, 1, part, want);
+      for (int threads : {1, 3}) {
+        SCOPED_TRACE("n " + std::to_string(n) + " threads " + std::to_string(threads));
+        TriangleBvh bvh;
+        bvh.build(part, threads);
+        ASSERT_EQ(static_cast<size_t>(bvh.node_count()), want.size());
+        const AABB everything{Vec3::Constant(-kInfinity), Vec3::Constant(kInfinity)};
+        for (std::int32_t k = 0; k < bvh.node_count(); ++k) {
+          std::vector<Index> got;
+          AABB box;
+          bvh.query_overlaps(everything, [](std::int32_t) { return false; }, [&](Index t) {
+            got.push_back(t);
+            box.extend(part[static_cast<size_t>(t)]);
+          }, k);
+          std::sort(got.begin(), got.end());
+          ASSERT_EQ(got, want[static_cast<size_t>(k)]) << "node " << k;
+          ASSERT_EQ(bvh.node_box(k).lo, box.lo) << "node " << k;
+          ASSERT_EQ(bvh.node_box(k).hi, box.hi) << "node " << k;
+        }
+      }
     }
   }
 }
