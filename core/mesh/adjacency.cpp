@@ -61,12 +61,14 @@ Adjacency::Adjacency(const Topology& topology) {
     for (const Index a : group) edges_.push_back({a, static_cast<Index>(b)});
   }
   first_edge[nv] = static_cast<Index>(edges_.size());
+  // A binary search in the group: a hub's group holds thousands (a fan of 20,000 triangles).
   auto edge_id = [&](Index a, Index b) {
     if (a == b) return kNoIndex;
     const Index lo = std::min(a, b), hi = std::max(a, b);
-    for (Index e = first_edge[static_cast<std::size_t>(hi)]; e < first_edge[static_cast<std::size_t>(hi) + 1]; ++e)
-      if (edges_[static_cast<std::size_t>(e)][0] == lo) return e;
-    return kNoIndex;  // not reached: every face edge is in its group
+    const auto first = edges_.begin() + first_edge[static_cast<std::size_t>(hi)];
+    const auto last = edges_.begin() + first_edge[static_cast<std::size_t>(hi) + 1];
+    const auto it = std::lower_bound(first, last, lo, [](const std::array<Index, 2>& e, Index v) { return e[0] < v; });
+    return it != last && (*it)[0] == lo ? static_cast<Index>(it - edges_.begin()) : kNoIndex;  // always found
   };
   tri_edges_.assign(nt, {kNoIndex, kNoIndex, kNoIndex});
   for (std::size_t t = 0; t < nt; ++t)
