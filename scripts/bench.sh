@@ -10,6 +10,7 @@
 #   bash scripts/bench.sh                      # 200 blobs x 180 triangles, 5 frames, 2 threads
 #   THREADS=4 REPEAT=5 bash scripts/bench.sh   # environment overrides (see below)
 #   bash scripts/bench.sh --fcl-threads 1      # extra options go to vproxq-bench-fcl
+#   bash scripts/bench.sh --repeat 1 --voronoi off   # and win over THREADS, REPEAT, VORONOI
 #
 # Environment: THREADS (2), REPEAT (3), OBJECTS (200), FREQUENCY (3: 180 triangles per blob),
 # FRAMES (5), SEED (1), VORONOI (off,cpu,gpu: the backends to time), JOBS (build jobs, default:
@@ -51,6 +52,19 @@ scene_dir=bench-out/blobs-$objects
 "$gen" blobs --objects "$objects" --frequency "$frequency" \
   --frames "$frames" --seed "$seed" --out "$scene_dir"
 
+# THREADS, REPEAT and VORONOI give --threads, --repeat and --voronoi unless the command line
+# does (vproxq-bench-fcl takes each once).
+given() {
+  local arg
+  for arg in "${@:2}"; do
+    case $arg in "$1" | "$1"=*) return 0 ;; esac
+  done
+  return 1
+}
+defaults=()
+given --threads "$@" || defaults+=(--threads "$threads")
+given --repeat "$@" || defaults+=(--repeat "$repeat")
+given --voronoi "$@" || defaults+=(--voronoi "$voronoi")
+
 echo
-"$fcl_bench" "$scene_dir/scene.json" --threads "$threads" \
-  --repeat "$repeat" --voronoi "$voronoi" "$@" | tee "$scene_dir/fcl-bench.txt"
+"$fcl_bench" "$scene_dir/scene.json" "${defaults[@]}" "$@" | tee "$scene_dir/fcl-bench.txt"
