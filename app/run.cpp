@@ -132,7 +132,10 @@ struct VoronoiStage {
   std::unique_ptr<CcdVoxelBackend> ccd_backend;       ///< the same kind, for CCD's Stage II
 };
 
-VoronoiStage make_voronoi_stage(const Config& config, int threads) {
+/// The backends a run uses: the inter-object one always (its name and device go into the
+/// output), the self one with the intra-object distance (`need_self`), CCD's with CCD
+/// (`need_ccd`): a GL backend compiles its shaders when made.
+VoronoiStage make_voronoi_stage(const Config& config, int threads, bool need_self, bool need_ccd) {
   VoronoiStage stage;
   if (config.voronoi == "off") return stage;
   gl::ContextOptions opts;
@@ -157,12 +160,12 @@ VoronoiStage make_voronoi_stage(const Config& config, int threads) {
     gl::GlCcdVoxelOptions ccd_options;
     ccd_options.cpu_threads = threads;
     stage.backend = std::make_unique<gl::GlVoronoiBackend>(*stage.context, gl_options);
-    stage.self_backend = std::make_unique<gl::GlSelfVoronoiBackend>(*stage.context, gl_options);
-    stage.ccd_backend = std::make_unique<gl::GlCcdVoxelBackend>(*stage.context, ccd_options);
+    if (need_self) stage.self_backend = std::make_unique<gl::GlSelfVoronoiBackend>(*stage.context, gl_options);
+    if (need_ccd) stage.ccd_backend = std::make_unique<gl::GlCcdVoxelBackend>(*stage.context, ccd_options);
   } else {
     stage.backend = make_cpu_voronoi_backend(threads);
-    stage.self_backend = make_cpu_self_voronoi_backend(threads);
-    stage.ccd_backend = make_cpu_ccd_voxel_backend(threads);
+    if (need_self) stage.self_backend = make_cpu_self_voronoi_backend(threads);
+    if (need_ccd) stage.ccd_backend = make_cpu_ccd_voxel_backend(threads);
   }
   return stage;
 }
@@ -294,7 +297,7 @@ void run(const Config& config) {
   }
   info.frame_count = static_cast<std::size_t>(last - first);
   const int grid = config.grid > 0 ? config.grid : scene.grid().value_or(0);
-  VoronoiStage voronoi = make_voronoi_stage(config, info.threads);
+  VoronoiStage voronoi = make_voronoi_stage(config, info.threads, want_distance && self, want_ccd);
   info.voronoi = voronoi.backend ? voronoi.backend->name() : "off";
   info.device = voronoi.backend ? voronoi.backend->device() : "";
   info.grid = voronoi.backend ? grid : 0;
