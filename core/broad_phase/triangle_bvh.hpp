@@ -142,6 +142,24 @@ class TriangleBvh {
   /// Per node, the largest value[t] over the triangles t of its subtree.
   std::vector<double> node_max(const std::vector<double>& value) const;
 
+  /// Per node, combine() of leaf(t) over the triangles t of its subtree, from `init`: a leaf
+  /// folds its triangles in order, an inner node its two children's values. Children come after
+  /// their parent in nodes_, so a reverse pass sees them first.
+  template <typename T, typename Leaf, typename Combine>
+  std::vector<T> fold_nodes(const T& init, const Leaf& leaf, const Combine& combine) const {
+    std::vector<T> out(nodes_.size(), init);
+    for (size_t n = nodes_.size(); n-- > 0;) {
+      const Node& node = nodes_[n];
+      if (node.count > 0) {
+        for (std::int32_t k = node.first; k < node.first + node.count; ++k)
+          out[n] = combine(out[n], leaf(order_[static_cast<size_t>(k)]));
+      } else {
+        out[n] = combine(out[static_cast<size_t>(node.first)], out[static_cast<size_t>(node.first) + 1]);
+      }
+    }
+    return out;
+  }
+
   class PairSearch;
 
  private:
@@ -220,23 +238,6 @@ class TriangleBvh {
       stack.push_back({a, nb.first + 1});
       stack.push_back({a, nb.first});
     }
-  }
-  /// Per node, combine() of leaf(t) over the triangles t of its subtree, from `init`: a leaf
-  /// folds its triangles in order, an inner node its two children's values. Children come after
-  /// their parent in nodes_, so a reverse pass sees them first.
-  template <typename T, typename Leaf, typename Combine>
-  std::vector<T> fold_nodes(const T& init, const Leaf& leaf, const Combine& combine) const {
-    std::vector<T> out(nodes_.size(), init);
-    for (size_t n = nodes_.size(); n-- > 0;) {
-      const Node& node = nodes_[n];
-      if (node.count > 0) {
-        for (std::int32_t k = node.first; k < node.first + node.count; ++k)
-          out[n] = combine(out[n], leaf(order_[static_cast<size_t>(k)]));
-      } else {
-        out[n] = combine(out[static_cast<size_t>(node.first)], out[static_cast<size_t>(node.first) + 1]);
-      }
-    }
-    return out;
   }
   std::vector<Node> nodes_;
   std::vector<Index> order_;

@@ -283,15 +283,55 @@ double margin_share(const AABB& raw) {
   return ccd_tolerance_share((raw.hi - raw.lo).maxCoeff(), m) + rounding_slack(m) * ccd_share_factor();
 }
 
+/// A point set's projections onto the four diagonals w = (1, ±1, ±1) (diagonal d: the signs of
+/// y and z from bits 0 and 1), smallest and largest: with the box, a 14-sided hull. A layer
+/// of cloth lying aslant to the axes is boxed with the layers above and below it; along the
+/// diagonal nearest its normal the two often come apart.
+struct Diagonals {
+  std::array<double, 4> lo{kInfinity, kInfinity, kInfinity, kInfinity};
+  std::array<double, 4> hi{-kInfinity, -kInfinity, -kInfinity, -kInfinity};
+
+  void extend(const Vec3& x) {
+    for (int d = 0; d < 4; ++d) {
+      const double p = (x[0] + ((d & 1) ? -x[1] : x[1])) + ((d & 2) ? -x[2] : x[2]);
+      lo[static_cast<size_t>(d)] = std::min(lo[static_cast<size_t>(d)], p);
+      hi[static_cast<size_t>(d)] = std::max(hi[static_cast<size_t>(d)], p);
+    }
+  }
+  void extend(const Diagonals& o) {
+    for (size_t d = 0; d < 4; ++d) {
+      lo[d] = std::min(lo[d], o.lo[d]);
+      hi[d] = std::max(hi[d], o.hi[d]);
+    }
+  }
+};
+
+/// apart_at_both_ends() along the diagonals: the points of a and b (a0, b0 at the start of the
+/// step, a1, b1 at its end) stay more than `gap` apart along some diagonal w, the same one of
+/// the two ahead at both ends (so at every time between: points_apart_along()). The projections
+/// are exact but for the two roundings of the sums (a few 2^-53 M, M the largest coordinate),
+/// far below the rounding slack that `gap` includes, and |w|^2 = 3.
+bool diagonals_apart(const Diagonals& a0, const Diagonals& a1, const Diagonals& b0, const Diagonals& b1, double gap) {
+  const double limit = 3 * gap * gap;
+  for (size_t d = 0; d < 4; ++d) {
+    const double ahead = std::max(std::min(b0.lo[d] - a0.hi[d], b1.lo[d] - a1.hi[d]),
+                                  std::min(a0.lo[d] - b0.hi[d], a1.lo[d] - b1.hi[d]));
+    if (ahead > 0 && ahead * ahead > limit) return true;
+  }
+  return false;
+}
+
 /// Per triangle and per BVH node: the boxes of its points at the start and at the end of the
 /// step, and its share of the culling margin (margin_share() of both boxes together: the
 /// triangles' from CcdSweep::shares). A pair
 /// of a triangle and a triangle or subtree uses the sum of their shares as its margin: if the
 /// kernel can report one of its queries, their swept boxes come within that query's margin on
 /// every axis, and there the shares add up to at least the margin (ccd_tolerance_share()).
+/// The same for the projections onto the diagonals (Diagonals).
 struct EndBoxes {
   std::vector<AABB> start, end, node_start, node_end;
   std::vector<double> share, node_share;
+  std::vector<Diagonals> diag_start, diag_end, node_diag_start, node_diag_end;
 
   static EndBoxes of(const std::vector<SweptTriangle>& tris, const TriangleBvh& bvh, const std::vector<double>& shares) {
     EndBoxes e;
@@ -305,6 +345,22 @@ struct EndBoxes {
       }
     e.node_start = bvh.node_unions(e.start);
     e.node_end = bvh.node_unions(e.end);
+    e.diag_start.resize(tris.size());
+    e.diag_end.resize(tris.size());
+    for (size_t t = 0; t < tris.size(); ++t)
+      for (size_t k = 0; k < 3; ++k) {
+        e.diag_start[t].extend(tris[t].start[k]);
+        e.diag_end[t].extend(tris[t].end[k]);
+      }
+    auto unions = [&bvh](const std::vector<Diagonals>& per_triangle) {
+      return bvh.fold_nodes(Diagonals{}, [&](Index t) { return per_triangle[static_cast<size_t>(t)]; },
+                            [](Diagonals x, const Diagonals& y) {
+                              x.extend(y);
+                              return x;
+                            });
+    };
+    e.node_diag_start = unions(e.diag_start);
+    e.node_diag_end = unions(e.diag_end);
     e.node_share.resize(e.node_start.size());
     for (size_t n = 0; n < e.node_start.size(); ++n) {
       AABB both = e.node_start[n];
@@ -762,8 +818,9 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
   // Within one object, the BVH is descended against itself (TriangleBvh::self_overlaps()),
   // from node pairs that split the search into units of work. A pair of subtrees is passed
   // over when a pivot is common to all their triangles (no primitive pair to test below:
-  // pivots()) or when they stay apart at both ends of the step (or, moving fast relative to
-  // each other, along the axes perpendicular to that motion).
+  // pivots()) or when they stay apart at both ends of the step, along x, y, z or a diagonal
+  // (Diagonals), or, moving fast relative to each other, along the axes perpendicular to that
+  // motion.
   std::vector<double> self_margin(from.objects.size(), 0.0);
   for (Index i : live) self_margin[static_cast<size_t>(i)] = sweep.pair_margin(i, i);
   auto self_apart = [&](Index i, std::int32_t a, std::int32_t b) {
@@ -775,7 +832,9 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
     const double gap = 2 * std::min(self_margin[ui], e.node_share[ua] + e.node_share[ub]);
     const AABB &a_start = e.node_start[ua], &a_end = e.node_end[ua];
     const AABB &b_start = e.node_start[ub], &b_end = e.node_end[ub];
-    if (apart_at_both_ends(a_start, a_end, b_start, b_end, gap)) return true;
+    if (apart_at_both_ends(a_start, a_end, b_start, b_end, gap) ||
+        diagonals_apart(e.node_diag_start[ua], e.node_diag_end[ua], e.node_diag_start[ub], e.node_diag_end[ub], gap))
+      return true;
     // Subtrees moving fast relative to each other (by more than twice the larger one's size):
     // the axes perpendicular to that motion, as in swept_apart().
     const Vec3 r = 0.5 * (((a_end.lo + a_end.hi) - (a_start.lo + a_start.hi)) - ((b_end.lo + b_end.hi) - (b_start.lo + b_start.hi)));
@@ -1057,6 +1116,8 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
       }
       if (!touching && (apart_at_both_ends(ends_i.start[static_cast<size_t>(f)], ends_i.end[static_cast<size_t>(f)],
                                            ends_j.start[static_cast<size_t>(g)], ends_j.end[static_cast<size_t>(g)], apart_gap) ||
+                        diagonals_apart(ends_i.diag_start[static_cast<size_t>(f)], ends_i.diag_end[static_cast<size_t>(f)],
+                                        ends_j.diag_start[static_cast<size_t>(g)], ends_j.diag_end[static_cast<size_t>(g)], apart_gap) ||
                         swept_apart(swept_i[static_cast<size_t>(f)], swept_j[static_cast<size_t>(g)], apart_gap))) {
         ++hits.counters.separated_pairs;
         return;
@@ -1091,7 +1152,10 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
         const AABB& n_start = ends_j.node_start[static_cast<size_t>(node)];
         const AABB& n_end = ends_j.node_end[static_cast<size_t>(node)];
         const double apart_gap = 2 * std::min(object_margin, f_share + ends_j.node_share[static_cast<size_t>(node)]);
-        if (apart_at_both_ends(f_start, f_end, n_start, n_end, apart_gap)) return true;
+        if (apart_at_both_ends(f_start, f_end, n_start, n_end, apart_gap) ||
+            diagonals_apart(ends_i.diag_start[static_cast<size_t>(f)], ends_i.diag_end[static_cast<size_t>(f)],
+                            ends_j.node_diag_start[static_cast<size_t>(node)], ends_j.node_diag_end[static_cast<size_t>(node)], apart_gap))
+          return true;
         // A triangle moving fast relative to the subtree (by more than twice its own size):
         // the axes perpendicular to that motion, as in swept_apart().
         const Vec3 r = f_motion - 0.5 * ((n_end.lo + n_end.hi) - (n_start.lo + n_start.hi));

@@ -203,6 +203,60 @@ TEST(CcdPipeline, LayersCloserThanTheObjectsMarginButApartAreCulled) {
   EXPECT_EQ(got.counters.elementary_tests(), alone);
 }
 
+// Two sheets lying aslant, with normal (1, 1, 1), two objects 0.2 apart along it (triangles 1
+// wide): every triangle's box overlaps many of the other sheet's and their hierarchies' boxes
+// overlap throughout, but along that diagonal the sheets stay apart while the top one slides, so
+// the other sheet's hierarchy is passed over at its root (Diagonals in ccd.cpp): no triangle
+// pair across them is looked at.
+TEST(CcdPipeline, SheetsAslantArePassedOverAlongTheDiagonals) {
+  const int n = 10;
+  const Vec3 u = Vec3(1, -1, 0).normalized(), v = Vec3(1, 1, -2).normalized(), normal = Vec3(1, 1, 1).normalized();
+  Frame from, to;
+  std::vector<Face> faces;
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const Index a = y * (n + 1) + x, b = a + 1, c = a + n + 1, d = c + 1;
+      faces.push_back({a, b, d});
+      faces.push_back({a, d, c});
+    }
+  for (int sheet = 0; sheet < 2; ++sheet) {
+    std::vector<Vec3> p;
+    for (int y = 0; y <= n; ++y)
+      for (int x = 0; x <= n; ++x) p.push_back(x * u + y * v + sheet * 0.2 * normal);
+    from.objects.push_back(test::make_object(p, faces, sheet == 0 ? "bottom" : "top"));
+  }
+  to.objects = from.objects;
+  to.index = 1;
+  for (Vec3& x : to.objects[1].positions) x += 0.3 * u;  // the top sheet slides
+  const CcdStepResult ref = continuous_collisions_brute_force(from, to);
+  EXPECT_EQ(ref.counters.limit_hits, 0u);
+  const CcdStepResult got = continuous_collisions(from, to, CcdOptions{2, nullptr});
+  expect_same_ccd(got, ref);
+  // Pairs across the sheets whose swept boxes overlap: what boxes alone would leave.
+  auto swept = [&](Index object, const Face& f) {
+    AABB b;
+    for (Index k : f) {
+      b.extend(from.objects[static_cast<size_t>(object)].positions[static_cast<size_t>(k)]);
+      b.extend(to.objects[static_cast<size_t>(object)].positions[static_cast<size_t>(k)]);
+    }
+    return b;
+  };
+  std::uint64_t boxed = 0;
+  for (const Face& f : faces)
+    for (const Face& g : faces) boxed += boxes_overlap(swept(0, f), swept(1, g));
+  EXPECT_GT(boxed, 1000u);
+  // The pairs looked at are those within each sheet alone.
+  std::uint64_t alone = 0;
+  for (size_t sheet = 0; sheet < 2; ++sheet) {
+    Frame a, b;
+    a.objects = {from.objects[sheet]};
+    b.objects = {to.objects[sheet]};
+    b.index = 1;
+    alone += continuous_collisions(a, b, CcdOptions{2, nullptr}).counters.triangle_pairs;
+  }
+  EXPECT_EQ(got.counters.triangle_pairs, alone) << boxed << " pairs across the sheets have overlapping boxes";
+}
+
 // A closed cylinder of n segments, its caps fans around a hub vertex, listed before its sides;
 // it turns a little and rises over the step, and one rim vertex of the top cap is pushed down
 // through the bottom cap (collisions with its triangles and edges). Every cap triangle's box
