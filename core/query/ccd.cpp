@@ -3,6 +3,7 @@
 #include "core/broad_phase/object_broad_phase.hpp"
 #include "core/broad_phase/triangle_bvh.hpp"
 #include "core/geometry/ccd.hpp"
+#include "core/geometry/diagonals.hpp"
 #include "core/geometry/separation_bound.hpp"
 #include "core/mesh/adjacency.hpp"
 #include "core/parallel.hpp"
@@ -283,34 +284,11 @@ double margin_share(const AABB& raw) {
   return ccd_tolerance_share((raw.hi - raw.lo).maxCoeff(), m) + rounding_slack(m) * ccd_share_factor();
 }
 
-/// A point set's projections onto the four diagonals w = (1, ±1, ±1) (diagonal d: the signs of
-/// y and z from bits 0 and 1), smallest and largest: with the box, a 14-sided hull. A layer
-/// of cloth lying aslant to the axes is boxed with the layers above and below it; along the
-/// diagonal nearest its normal the two often come apart.
-struct Diagonals {
-  std::array<double, 4> lo{kInfinity, kInfinity, kInfinity, kInfinity};
-  std::array<double, 4> hi{-kInfinity, -kInfinity, -kInfinity, -kInfinity};
-
-  void extend(const Vec3& x) {
-    for (int d = 0; d < 4; ++d) {
-      const double p = (x[0] + ((d & 1) ? -x[1] : x[1])) + ((d & 2) ? -x[2] : x[2]);
-      lo[static_cast<size_t>(d)] = std::min(lo[static_cast<size_t>(d)], p);
-      hi[static_cast<size_t>(d)] = std::max(hi[static_cast<size_t>(d)], p);
-    }
-  }
-  void extend(const Diagonals& o) {
-    for (size_t d = 0; d < 4; ++d) {
-      lo[d] = std::min(lo[d], o.lo[d]);
-      hi[d] = std::max(hi[d], o.hi[d]);
-    }
-  }
-};
-
-/// apart_at_both_ends() along the diagonals: the points of a and b (a0, b0 at the start of the
-/// step, a1, b1 at its end) stay more than `gap` apart along some diagonal w, the same one of
-/// the two ahead at both ends (so at every time between: points_apart_along()). The projections
-/// are exact but for the two roundings of the sums (a few 2^-53 M, M the largest coordinate),
-/// far below the rounding slack that `gap` includes, and |w|^2 = 3.
+/// apart_at_both_ends() along the diagonals (Diagonals): the points of a and b (a0, b0 at the
+/// start of the step, a1, b1 at its end) stay more than `gap` apart along some diagonal w, the
+/// same one of the two ahead at both ends (so at every time between: points_apart_along()).
+/// The projections are exact but for the two roundings of the sums (a few 2^-53 M, M the
+/// largest coordinate), far below the rounding slack that `gap` includes, and |w|^2 = 3.
 bool diagonals_apart(const Diagonals& a0, const Diagonals& a1, const Diagonals& b0, const Diagonals& b1, double gap) {
   const double limit = 3 * gap * gap;
   for (size_t d = 0; d < 4; ++d) {

@@ -1,6 +1,7 @@
 #include "core/query/intra_distance.hpp"
 
 #include "core/broad_phase/triangle_bvh.hpp"
+#include "core/geometry/diagonals.hpp"
 #include "core/geometry/separation_bound.hpp"
 #include "core/mesh/adjacency.hpp"
 #include "core/parallel.hpp"
@@ -193,6 +194,7 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     std::vector<std::array<Index, 3>> common;
     std::vector<double> reach, node_lower;
     std::vector<SeparationSite> sites;  ///< per triangle: its part of separation_lower_bound()
+    std::vector<Diagonals> diagonals, node_diagonals;
     double slack = 0;
   };
   std::vector<ObjectSearch> search(n_obj);
@@ -206,15 +208,17 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
   std::vector<std::vector<TriangleBvh::NodePair>> units(n_obj);
   // Whether the descent enters the node pair (a, b) of object i: not when every pair of their
   // triangles shares a vertex (a vertex common to both nodes' triangles), else when a triangle
-  // of one side may need a triangle of the other: the nodes' boxes within the first side's
-  // reach, and (Stage II) the second side's smallest D_l too.
+  // of one side may need a triangle of the other: the nodes' boxes (and their projections on
+  // the diagonals, Diagonals: the gap along one divided by sqrt(3), when larger) within the
+  // first side's reach, and (Stage II) the second side's smallest D_l too.
   auto enter = [&](size_t i, std::int32_t a, std::int32_t b) {
     const ObjectSearch& s = search[i];
     const auto& ca = s.common[static_cast<size_t>(a)];
     if (a == b) return ca[0] == kNoIndex;
     if (TriangleBvh::adjacent_subtree(ca, s.common[static_cast<size_t>(b)])) return false;
     const TriangleBvh& bvh = boxes.bvh(i);
-    const double d2 = box_distance_squared(bvh.node_box(a), bvh.node_box(b));
+    const double gap = diagonal_gap(s.node_diagonals[static_cast<size_t>(a)], s.node_diagonals[static_cast<size_t>(b)]);
+    const double d2 = std::max(box_distance_squared(bvh.node_box(a), bvh.node_box(b)), gap * gap / 3);
     const double ra = s.reach[static_cast<size_t>(a)], rb = s.reach[static_cast<size_t>(b)];
     const bool lower = !s.node_lower.empty();
     return (d2 <= ra * ra && (!lower || s.node_lower[static_cast<size_t>(b)] <= ra)) ||
@@ -232,6 +236,14 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     s.common = bvh.node_common_vertices(frame.objects[i].topology->faces);
     s.sites.resize(n);
     for (size_t t = 0; t < n; ++t) s.sites[t] = separation_site(frame.objects[i].triangle(static_cast<Index>(t)));
+    s.diagonals.resize(n);
+    for (size_t t = 0; t < n; ++t)
+      for (const Vec3& x : frame.objects[i].triangle(static_cast<Index>(t))) s.diagonals[t].extend(x);
+    s.node_diagonals = bvh.fold_nodes(Diagonals{}, [&](Index t) { return s.diagonals[static_cast<size_t>(t)]; },
+                                      [](Diagonals x, const Diagonals& y) {
+                                        x.extend(y);
+                                        return x;
+                                      });
     // D_u(t): the 2-ring bound, or Stage II's (which already includes it) when smaller.
     s.upper = ring2_bound[i];
     if (voronoi)
@@ -247,7 +259,7 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     for (const auto& pair : units[i]) tasks.push_back({i, pair});
 
   // Each unordered pair of non-adjacent triangles (f, g) of an entered pair of leaves is a
-  // candidate for f when their boxes lie within f's bound, min(D_u(f), f's best so far) + slack
+  // candidate for f when their boxes (and diagonals) lie within f's bound, min(D_u(f), f's best so far) + slack
   // (and, with Stage II, D_l(g) does too: a pair at distance d within it has
   // D_l(g) <= SD(g) <= d), and likewise for g. A side's candidate is culled when the pair's
   // separation bound exceeds its bound; a pair that is still a candidate for either side is
@@ -323,7 +335,8 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     boxes.bvh(i).descend_self(tasks[k].pair, [&](std::int32_t a, std::int32_t b) { return enter(i, a, b); },
                               [&](Index t, Index u, const AABB& bt, const AABB& bu) {
       const Index f = std::min(t, u), g = std::max(t, u);
-      const double d2 = box_distance_squared(bt, bu);
+      const double gap = diagonal_gap(s.diagonals[static_cast<size_t>(f)], s.diagonals[static_cast<size_t>(g)]);
+      const double d2 = std::max(box_distance_squared(bt, bu), gap * gap / 3);
       const double bf = bound(static_cast<size_t>(f)), bg = bound(static_cast<size_t>(g));
       if ((d2 > bf * bf && d2 > bg * bg) || shares_vertex(o, f, g)) return;
       if (d2 > 0) {
