@@ -1094,8 +1094,10 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
       }
       if (!touching && (apart_at_both_ends(ends_i.start[static_cast<size_t>(f)], ends_i.end[static_cast<size_t>(f)],
                                            ends_j.start[static_cast<size_t>(g)], ends_j.end[static_cast<size_t>(g)], apart_gap) ||
-                        diagonals_apart(ends_i.diag_start[static_cast<size_t>(f)], ends_i.diag_end[static_cast<size_t>(f)],
-                                        ends_j.diag_start[static_cast<size_t>(g)], ends_j.diag_end[static_cast<size_t>(g)], apart_gap) ||
+                        diagonals_apart(ends_i.diag_start[static_cast<size_t>(f)],
+                                        ends_i.diag_end[static_cast<size_t>(f)],
+                                        ends_j.diag_start[static_cast<size_t>(g)],
+                                        ends_j.diag_end[static_cast<size_t>(g)], apart_gap) ||
                         swept_apart(swept_i[static_cast<size_t>(f)], swept_j[static_cast<size_t>(g)], apart_gap))) {
         ++hits.counters.separated_pairs;
         return;
@@ -1132,7 +1134,8 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
         const double apart_gap = 2 * std::min(object_margin, f_share + ends_j.node_share[static_cast<size_t>(node)]);
         if (apart_at_both_ends(f_start, f_end, n_start, n_end, apart_gap) ||
             diagonals_apart(ends_i.diag_start[static_cast<size_t>(f)], ends_i.diag_end[static_cast<size_t>(f)],
-                            ends_j.node_diag_start[static_cast<size_t>(node)], ends_j.node_diag_end[static_cast<size_t>(node)], apart_gap))
+                            ends_j.node_diag_start[static_cast<size_t>(node)],
+                            ends_j.node_diag_end[static_cast<size_t>(node)], apart_gap))
           return true;
         // A triangle moving fast relative to the subtree (by more than twice its own size):
         // the axes perpendicular to that motion, as in swept_apart().

@@ -210,7 +210,9 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
   // triangles shares a vertex (a vertex common to both nodes' triangles), else when a triangle
   // of one side may need a triangle of the other: the nodes' boxes (and their projections on
   // the diagonals, Diagonals: the gap along one divided by sqrt(3), when larger) within the
-  // first side's reach, and (Stage II) the second side's smallest D_l too.
+  // first side's reach, and (Stage II) the second side's smallest D_l too. The projections
+  // are off by a few 2^-53 M (M: the object's largest coordinate), far below the rounding
+  // slack in the reach, so a pair passed over is farther apart than its bounds.
   auto enter = [&](size_t i, std::int32_t a, std::int32_t b) {
     const ObjectSearch& s = search[i];
     const auto& ca = s.common[static_cast<size_t>(a)];
@@ -259,13 +261,13 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     for (const auto& pair : units[i]) tasks.push_back({i, pair});
 
   // Each unordered pair of non-adjacent triangles (f, g) of an entered pair of leaves is a
-  // candidate for f when their boxes (and diagonals) lie within f's bound, min(D_u(f), f's best so far) + slack
-  // (and, with Stage II, D_l(g) does too: a pair at distance d within it has
-  // D_l(g) <= SD(g) <= d), and likewise for g. A side's candidate is culled when the pair's
-  // separation bound exceeds its bound; a pair that is still a candidate for either side is
-  // evaluated once and offered to both. So every triangle's nearest pair is evaluated: at
-  // every level its boxes lie within the triangle's bound, which never drops below that
-  // pair's distance.
+  // candidate for f when their boxes (and diagonals, as above) lie within f's bound,
+  // min(D_u(f), f's best so far) + slack (and, with Stage II, D_l(g) does too: a pair at
+  // distance d within it has D_l(g) <= SD(g) <= d), and likewise for g. A side's candidate
+  // is culled when the pair's separation bound exceeds its bound; a pair that is still a
+  // candidate for either side is evaluated once and offered to both. So every triangle's
+  // nearest pair is evaluated: at every level its boxes lie within the triangle's bound, which
+  // never drops below that pair's distance.
   std::vector<DistanceCounters> counters(tasks.size());
   std::vector<std::vector<IntersectingPair>> hits(tasks.size());
   parallel_for(tasks.size(), threads, [&](size_t k) {
