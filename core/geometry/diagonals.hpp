@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <vector>
 
 namespace vproxq {
 
@@ -30,6 +31,17 @@ struct Diagonals {
     }
   }
 };
+
+/// Per node of a hierarchy (TriangleBvh), the Diagonals of its subtree's triangles, from each
+/// triangle's (indexed by triangle id).
+template <typename Bvh>
+std::vector<Diagonals> node_diagonals(const Bvh& bvh, const std::vector<Diagonals>& per_triangle) {
+  return bvh.fold_nodes(Diagonals{}, [&](Index t) { return per_triangle[static_cast<size_t>(t)]; },
+                        [](Diagonals x, const Diagonals& y) {
+                          x.extend(y);
+                          return x;
+                        });
+}
 
 /// The largest gap between the projections of a and b onto one diagonal (0 when they overlap
 /// on all four): divided by sqrt(3), a lower bound on the distance between the two sets (up

@@ -316,29 +316,19 @@ struct EndBoxes {
     e.start.resize(tris.size());
     e.end.resize(tris.size());
     e.share = shares;
-    for (size_t t = 0; t < tris.size(); ++t)
-      for (size_t k = 0; k < 3; ++k) {
-        e.start[t].extend(tris[t].start[k]);
-        e.end[t].extend(tris[t].end[k]);
-      }
-    e.node_start = bvh.node_unions(e.start);
-    e.node_end = bvh.node_unions(e.end);
     e.diag_start.resize(tris.size());
     e.diag_end.resize(tris.size());
     for (size_t t = 0; t < tris.size(); ++t)
       for (size_t k = 0; k < 3; ++k) {
+        e.start[t].extend(tris[t].start[k]);
+        e.end[t].extend(tris[t].end[k]);
         e.diag_start[t].extend(tris[t].start[k]);
         e.diag_end[t].extend(tris[t].end[k]);
       }
-    auto unions = [&bvh](const std::vector<Diagonals>& per_triangle) {
-      return bvh.fold_nodes(Diagonals{}, [&](Index t) { return per_triangle[static_cast<size_t>(t)]; },
-                            [](Diagonals x, const Diagonals& y) {
-                              x.extend(y);
-                              return x;
-                            });
-    };
-    e.node_diag_start = unions(e.diag_start);
-    e.node_diag_end = unions(e.diag_end);
+    e.node_start = bvh.node_unions(e.start);
+    e.node_end = bvh.node_unions(e.end);
+    e.node_diag_start = node_diagonals(bvh, e.diag_start);
+    e.node_diag_end = node_diagonals(bvh, e.diag_end);
     e.node_share.resize(e.node_start.size());
     for (size_t n = 0; n < e.node_start.size(); ++n) {
       AABB both = e.node_start[n];

@@ -241,11 +241,7 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     s.diagonals.resize(n);
     for (size_t t = 0; t < n; ++t)
       for (const Vec3& x : frame.objects[i].triangle(static_cast<Index>(t))) s.diagonals[t].extend(x);
-    s.node_diagonals = bvh.fold_nodes(Diagonals{}, [&](Index t) { return s.diagonals[static_cast<size_t>(t)]; },
-                                      [](Diagonals x, const Diagonals& y) {
-                                        x.extend(y);
-                                        return x;
-                                      });
+    s.node_diagonals = node_diagonals(bvh, s.diagonals);
     // D_u(t): the 2-ring bound, or Stage II's (which already includes it) when smaller.
     s.upper = ring2_bound[i];
     if (voronoi)
