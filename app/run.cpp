@@ -368,6 +368,11 @@ void run(const Config& config) {
       // distance searched come from its exact tests (it meets every such pair).
       sw.restart();
       IntersectingPairsOptions ip_options{info.threads, opts.voronoi, true};
+      std::vector<double> object_distance;
+      if (result.inter) {
+        for (const InterObjectDistance& d : *result.inter) object_distance.push_back(d.distance);
+        ip_options.object_distance = &object_distance;
+      }
       if (want_distance && self) {
         ip_options.intra_pairs = &intra_pairs;
         ip_options.intra_skip = &intra_left_out;

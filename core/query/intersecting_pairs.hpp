@@ -19,6 +19,10 @@ struct IntersectingPairsOptions {
   /// intra-object search does not use them (D_l is a distance to other objects).
   const VoronoiBounds* voronoi = nullptr;
   bool intra = true;  ///< also list pairs within one object
+  /// Per object, its exact distance to the nearest other object (the inter-object distance's
+  /// answers, InterObjectDistance::distance), or null. An object at positive distance from
+  /// all others intersects none of them, so object pairs with such an object are skipped.
+  const std::vector<double>* object_distance = nullptr;
   /// With `intra`: the pairs within objects that the intra-object distance already found
   /// (IntraDistanceOutput::intersecting), all those of every object but the ones its `skip`
   /// left out (`intra_skip`, the same mask, may be null). Those objects are not searched

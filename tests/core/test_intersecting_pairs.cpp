@@ -4,6 +4,7 @@
 #include "core/geometry/predicates.hpp"
 #include "core/geometry/triangle_box.hpp"
 #include "core/mesh/adjacency.hpp"
+#include "core/query/inter_distance.hpp"
 #include "core/query/intersecting_pairs.hpp"
 #include "core/voronoi/stage2.hpp"
 #include "support/random_scene.hpp"
@@ -244,6 +245,33 @@ TEST(IntersectingPairs, WithCpuVoronoiBoundsEqualBruteForce) {
       EXPECT_EQ(got.pairs, ref.pairs);
     }
   }
+}
+
+TEST(IntersectingPairs, WithTheInterObjectDistancesEqualBruteForce) {
+  // The run passes each object's distance to its nearest other object: pairs with an object
+  // at positive distance from all others are skipped. Same list; fewer tests where a skipped
+  // pair's boxes overlap.
+  std::uint64_t tests_with = 0, tests_without = 0;
+  int apart = 0;
+  for (std::uint64_t seed = 1; seed <= 16; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const Frame frame = mixed_frame(seed);
+    const FrameBoxes boxes = FrameBoxes::compute(frame, 2);
+    std::vector<double> distance;
+    for (const auto& d : inter_object_distance(frame, {2, nullptr}).per_object) {
+      distance.push_back(d.distance);
+      apart += d.distance > 0;
+    }
+    const auto ref = intersecting_pairs_brute_force(frame);
+    IntersectingPairsOptions opts{2, nullptr, true};
+    tests_without += intersecting_pairs(frame, boxes, opts).exact_tests;
+    opts.object_distance = &distance;
+    const auto got = intersecting_pairs(frame, boxes, opts);
+    EXPECT_EQ(got.pairs, ref.pairs);
+    tests_with += got.exact_tests;
+  }
+  EXPECT_GT(apart, 10);
+  EXPECT_LT(tests_with, tests_without);
 }
 
 TEST(IntersectingPairs, SeparatedAndTouchingObjects) {

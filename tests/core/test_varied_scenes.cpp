@@ -126,14 +126,18 @@ void expect_every_query_equals_brute_force(const Frame& frame, const Frame& to, 
 
   const auto pairs_ref = intersecting_pairs_brute_force(frame);
   seen.intersecting += pairs_ref.pairs.size();
-  for (const VoronoiBounds* v : {static_cast<const VoronoiBounds*>(nullptr), &vb}) {
-    IntersectingPairsOptions opts;
-    opts.threads = threads;
-    opts.voronoi = v;
-    const auto got = intersecting_pairs(frame, boxes, opts);
-    ASSERT_EQ(got.pairs.size(), pairs_ref.pairs.size()) << (v ? "pairs cpu" : "pairs off");
-    for (size_t k = 0; k < got.pairs.size(); ++k) EXPECT_TRUE(got.pairs[k] == pairs_ref.pairs[k]) << "pair " << k;
-  }
+  std::vector<double> object_distance;  // as the run passes them
+  for (const auto& d : inter_ref.per_object) object_distance.push_back(d.distance);
+  for (const VoronoiBounds* v : {static_cast<const VoronoiBounds*>(nullptr), &vb})
+    for (const std::vector<double>* apart : std::initializer_list<const std::vector<double>*>{nullptr, &object_distance}) {
+      IntersectingPairsOptions opts;
+      opts.threads = threads;
+      opts.voronoi = v;
+      opts.object_distance = apart;
+      const auto got = intersecting_pairs(frame, boxes, opts);
+      ASSERT_EQ(got.pairs.size(), pairs_ref.pairs.size()) << (v ? "pairs cpu" : "pairs off") << (apart ? ", distances" : "");
+      for (size_t k = 0; k < got.pairs.size(); ++k) EXPECT_TRUE(got.pairs[k] == pairs_ref.pairs[k]) << "pair " << k;
+    }
 
   const CcdStepResult ccd_ref = continuous_collisions_brute_force(frame, to);
   seen.collisions += ccd_ref.vf.size() + ccd_ref.ee.size();

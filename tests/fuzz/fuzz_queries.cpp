@@ -117,12 +117,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
 
   const auto pairs_ref = intersecting_pairs_brute_force(from);
+  std::vector<double> object_distance;
+  for (const auto& d : inter_ref.per_object) object_distance.push_back(d.distance);
   for (const VoronoiBounds* v : {static_cast<const VoronoiBounds*>(nullptr), &vb}) {
     IntersectingPairsOptions opts;
     opts.threads = threads;
     opts.voronoi = v;
-    const auto got = intersecting_pairs(from, boxes, opts);
-    VPROXQ_FUZZ_CHECK(got.pairs == pairs_ref.pairs);
+    VPROXQ_FUZZ_CHECK(intersecting_pairs(from, boxes, opts).pairs == pairs_ref.pairs);
+    opts.object_distance = &object_distance;  // as the run passes them
+    VPROXQ_FUZZ_CHECK(intersecting_pairs(from, boxes, opts).pairs == pairs_ref.pairs);
   }
   PenetrationDepthOptions pd;
   pd.threads = threads;
