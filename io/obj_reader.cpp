@@ -7,6 +7,7 @@
 #include <limits>
 #include <string>
 #include <string_view>
+#include <utility>
 
 namespace vproxq::io_detail {
 
@@ -45,9 +46,6 @@ void for_each_line(const std::string& text, F&& f) {
   }
 }
 
-/// First keyword of a line, or empty for blank lines.
-std::string_view keyword(std::string_view line) { return next_token(line); }
-
 struct RawGroup {
   std::string name;         ///< empty: unnamed
   std::vector<Face> faces;  ///< global (file) vertex indices
@@ -58,13 +56,21 @@ class ObjParser {
   ObjParser(const fs::path& file, const std::string& text) : file_(file), text_(text) {}
 
   void parse() {
-    count_vertices();
-    positions_.reserve(static_cast<std::size_t>(total_vertices_));
+    // A vertex line and its share of the faces take about 100 bytes; the vector grows past that.
+    positions_.reserve(text_.size() / 128);
     groups_.emplace_back();  // faces before any o/g
     for_each_line(text_, [this](long line_no, std::string_view line) {
       line_no_ = line_no;
       parse_line(line);
     });
+    // Positive face indices may name vertices defined further down; those beyond the vertices
+    // read so far were noted, and are checked now that the count is known (the first such line).
+    for (const auto& [line_no, idx] : forward_)
+      if (idx > static_cast<long long>(positions_.size())) {
+        line_no_ = line_no;
+        fail("face index " + std::to_string(idx) + " out of range (file has " +
+             std::to_string(positions_.size()) + " vertices)");
+      }
   }
 
   std::vector<MeshGroup> result(ObjGroups mode) {
@@ -101,9 +107,23 @@ class ObjParser {
     for (std::size_t k = 0; k < with_faces.size(); ++k) {
       RawGroup& g = *with_faces[k];
       used.clear();
-      for (const Face& f : g.faces) used.insert(used.end(), f.begin(), f.end());
-      std::sort(used.begin(), used.end());
-      used.erase(std::unique(used.begin(), used.end()), used.end());
+      // The vertices the group uses, in global order: marked in `local` and read off in order
+      // where their range is within a few times the corners (a group's vertices usually follow
+      // each other in the file), else sorted.
+      Index lo = std::numeric_limits<Index>::max(), hi = 0;
+      for (const Face& f : g.faces)
+        for (Index v : f) lo = std::min(lo, v), hi = std::max(hi, v);
+      const std::size_t corners = 3 * g.faces.size();
+      if (static_cast<std::size_t>(hi - lo) < 4 * corners) {
+        for (const Face& f : g.faces)
+          for (Index v : f) local[static_cast<std::size_t>(v)] = 0;
+        for (Index v = lo; v <= hi; ++v)
+          if (local[static_cast<std::size_t>(v)] == 0) used.push_back(v);
+      } else {
+        for (const Face& f : g.faces) used.insert(used.end(), f.begin(), f.end());
+        std::sort(used.begin(), used.end());
+        used.erase(std::unique(used.begin(), used.end()), used.end());
+      }
       MeshGroup mg;
       mg.name = g.name.empty() ? stem + "_" + std::to_string(k) : g.name;
       mg.file_named = g.name.empty() && unnamed == 1;
@@ -129,26 +149,11 @@ class ObjParser {
     throw_input_error(file_, "line " + std::to_string(line_no_) + ": " + what);
   }
 
-  /// Positive face indices are checked against the file's total vertex count, so count the
-  /// `v` lines first (a cheap scan; the second pass parses them).
-  void count_vertices() {
-    long long n = 0;
-    for_each_line(text_, [&n](long, std::string_view line) {
-      if (keyword(line) == "v") ++n;
-    });
-    if (n > std::numeric_limits<Index>::max()) {
-      throw_input_error(file_, "too many vertices (" + std::to_string(n) + "), at most " +
-                                   std::to_string(std::numeric_limits<Index>::max()) +
-                                   " are supported");
-    }
-    total_vertices_ = static_cast<Index>(n);
-  }
-
   void parse_line(std::string_view line) {
     std::string_view rest = line;
     const std::string_view kw = next_token(rest);
     if (kw.empty() || is_comment(kw)) return;
-    if (!trim(rest).empty() && trim(rest).back() == '\\' && kw != "o" && kw != "g") {
+    if (const std::string_view t = trim(rest); !t.empty() && t.back() == '\\' && kw != "o" && kw != "g") {
       fail("line continuation with '\\' is not supported");
     }
     if (kw == "v") return parse_vertex(rest);
@@ -192,6 +197,9 @@ class ObjParser {
     }
     if (const std::string problem = coordinate_problem(p); !problem.empty())
       fail("vertex " + std::to_string(positions_.size() + 1) + " " + problem);
+    if (positions_.size() >= static_cast<std::size_t>(std::numeric_limits<Index>::max()))
+      fail("too many vertices (more than " + std::to_string(std::numeric_limits<Index>::max()) +
+           "; at most that many are supported)");
     positions_.push_back(p);
   }
 
@@ -219,9 +227,9 @@ class ObjParser {
     if (count == 2 && parts[1].empty()) fail("malformed face corner: empty texture index");
     if (idx == 0) fail("face index 0 is invalid (OBJ indices start at 1)");
     if (idx > 0) {
-      if (idx > total_vertices_) {
-        fail("face index " + std::to_string(idx) + " out of range (file has " +
-             std::to_string(total_vertices_) + " vertices)");
+      if (idx > static_cast<long long>(positions_.size())) {
+        // A vertex further down, or none: parse() checks once the file's count is known.
+        forward_.emplace_back(line_no_, idx);
       }
       return static_cast<Index>(idx - 1);
     }
@@ -251,7 +259,7 @@ class ObjParser {
   const fs::path& file_;
   const std::string& text_;
   long line_no_ = 0;
-  Index total_vertices_ = 0;
+  std::vector<std::pair<long, long long>> forward_;  ///< (line, index) past the vertices read
   std::vector<Vec3> positions_;
   std::vector<RawGroup> groups_;
   std::vector<Index> corners_;

@@ -95,6 +95,9 @@ const char* axis_name(int axis) {
 
 std::string coordinate_problem(const Vec3& p) {
   for (int a = 0; a < 3; ++a) {
+    if (std::isfinite(p[a]) && std::abs(p[a]) < kMaxCoordinateMagnitude &&
+        (p[a] == 0 || std::abs(p[a]) >= kMinCoordinateMagnitude))
+      continue;
     // The shortest text that reads back as the same double ("1e+61", "nan", "-inf").
     char value[64] = {};
     std::to_chars(value, value + sizeof value - 1, p[a]);

@@ -138,6 +138,21 @@ TEST(ObjReader, SeveralGroupsGetTheVerticesTheyUseInFileOrder) {
   EXPECT_EQ(groups[1].faces, faces({{1, 2, 3}, {3, 2, 0}}));
 }
 
+TEST(ObjReader, GroupsWithScatteredVerticesKeepFileOrderToo) {
+  // A group's vertices are collected by marking their range where it is a few times the
+  // corners, else by sorting: both give file order.
+  TempDir dir;
+  std::string text;
+  for (int i = 1; i <= 50; ++i) text += "v " + std::to_string(i) + " 0 " + std::to_string(i % 7) + "\n";
+  text += "o near\nf 10 12 11\no far\nf 50 1 25\nf 25 1 49\n";
+  const auto groups = read_mesh_file(dir.write("scattered.obj", text));
+  ASSERT_EQ(groups.size(), 2u);
+  EXPECT_EQ(groups[0].positions, (std::vector<Vec3>{{10, 0, 3}, {11, 0, 4}, {12, 0, 5}}));
+  EXPECT_EQ(groups[0].faces, faces({{0, 2, 1}}));
+  EXPECT_EQ(groups[1].positions, (std::vector<Vec3>{{1, 0, 1}, {25, 0, 4}, {49, 0, 0}, {50, 0, 1}}));
+  EXPECT_EQ(groups[1].faces, faces({{3, 0, 1}, {1, 0, 2}}));
+}
+
 TEST(ObjReader, UnnamedGroupsAreNamedAfterTheFileStem) {
   TempDir dir;
   const auto file = dir.write("parts.obj",
@@ -244,6 +259,14 @@ TEST(ObjReaderErrors, FaceIndexOutOfRange) {
   const auto file = dir.write("a_0003.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 812\n");
   EXPECT_INPUT_ERROR(read_mesh_file(file),
                      file.string() + ": line 5: face index 812 out of range (file has 3 vertices)");
+  // Indices past the vertices read so far are checked once the file's count is known: the
+  // first line with one past the count is named, not a valid forward reference before it.
+  const auto fwd = dir.write("fwd.obj", "f 1 2 3\nf 3 2 1\nf 1 4 9\nf 1 2 7\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(fwd),
+                     fwd.string() + ": line 3: face index 9 out of range (file has 4 vertices)");
+  const auto huge = dir.write("huge.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999\n");
+  EXPECT_INPUT_ERROR(read_mesh_file(huge),
+                     huge.string() + ": line 4: face index 99999999999 out of range (file has 3 vertices)");
 }
 
 TEST(ObjReaderErrors, ZeroFaceIndex) {
