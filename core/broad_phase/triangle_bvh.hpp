@@ -3,6 +3,7 @@
 // feature-level candidate search of Stage III: which triangles' boxes come within a bound of
 // a query box (the paper's expanded-AABB overlap test, without scanning every triangle).
 #include "core/broad_phase/aabb.hpp"
+#include "core/geometry/diagonals.hpp"
 
 #include <algorithm>
 #include <array>
@@ -381,10 +382,23 @@ class TriangleBvh::PairSearch {
   /// `bound`; returns its index either way (pairs are numbered in the order added). Both must
   /// outlive the search.
   std::size_t add(const TriangleBvh& a, const TriangleBvh& b, double bound) {
+    return add(a, b, bound, nullptr, nullptr);
+  }
+  /// The same where distances are also bounded by the projections onto the diagonals: per
+  /// hierarchy, those of its nodes and triangles (HierarchyDiagonals). Boxes' squared
+  /// distances are raised to gap^2 / 3 (diagonal_gap()) where that is larger, for the order,
+  /// the bound and the d2 passed to visit alike; the caller's bound must carry a slack above
+  /// the projections' rounding (a few 2^-53 of the largest coordinate).
+  struct HierarchyDiagonals {
+    std::vector<Diagonals> nodes;      ///< per node (node_diagonals())
+    std::vector<Diagonals> triangles;  ///< per triangle id
+  };
+  std::size_t add(const TriangleBvh& a, const TriangleBvh& b, double bound, const HierarchyDiagonals* da,
+                  const HierarchyDiagonals* db) {
     const std::size_t p = pairs_.size();
-    pairs_.push_back({&a, &b});
+    pairs_.push_back({&a, &b, da && db ? da : nullptr, da && db ? db : nullptr});
     if (!a.nodes_.empty() && !b.nodes_.empty()) {
-      const double d2 = box_distance_squared(a.nodes_[0].box, b.nodes_[0].box);
+      const double d2 = node_d2(pairs_.back(), 0, 0);
       if (d2 <= bound * bound) push({d2, static_cast<std::int32_t>(p), 0, 0, a.node_min_ids_[0]});
     }
     return p;
@@ -402,7 +416,18 @@ class TriangleBvh::PairSearch {
   struct Pair {
     const TriangleBvh* a;
     const TriangleBvh* b;
+    const HierarchyDiagonals* da;  ///< both null, or both set
+    const HierarchyDiagonals* db;
   };
+  static double raise(double d2, const Diagonals& x, const Diagonals& y) {
+    const double gap = diagonal_gap(x, y);
+    return std::max(d2, gap * gap / 3);
+  }
+  static double node_d2(const Pair& p, std::int32_t na, std::int32_t nb) {
+    const auto ua = static_cast<std::size_t>(na), ub = static_cast<std::size_t>(nb);
+    const double d2 = box_distance_squared(p.a->nodes_[ua].box, p.b->nodes_[ub].box);
+    return p.da ? raise(d2, p.da->nodes[ua], p.db->nodes[ub]) : d2;
+  }
   struct Entry {
     double d2;
     std::int32_t pair;
@@ -440,27 +465,30 @@ void TriangleBvh::PairSearch::run(const Bound& bound, const KeepNode& keep_node,
     const TriangleBvh& tb = *pairs_[p].b;
     const Node& na = ta.nodes_[static_cast<std::size_t>(e.node_a)];
     const Node& nb = tb.nodes_[static_cast<std::size_t>(e.node_b)];
+    const Pair& pr = pairs_[p];
     if (na.count > 0 && nb.count > 0) {
       for (std::int32_t i = na.first; i < na.first + na.count; ++i) {
         const Index t = ta.order_[static_cast<std::size_t>(i)];
         if (!keep_triangle(p, t)) continue;
         const AABB& box = ta.leaf_boxes_[static_cast<std::size_t>(i)];
         for (std::int32_t k = nb.first; k < nb.first + nb.count; ++k) {
-          const double d2 = box_distance_squared(box, tb.leaf_boxes_[static_cast<std::size_t>(k)]);
+          const Index u = tb.order_[static_cast<std::size_t>(k)];
+          double d2 = box_distance_squared(box, tb.leaf_boxes_[static_cast<std::size_t>(k)]);
+          if (pr.da) d2 = raise(d2, pr.da->triangles[static_cast<std::size_t>(t)], pr.db->triangles[static_cast<std::size_t>(u)]);
           const double bk = bound();
-          if (d2 <= bk * bk) visit(p, t, tb.order_[static_cast<std::size_t>(k)], d2);
+          if (d2 <= bk * bk) visit(p, t, u, d2);
         }
       }
       continue;
     }
     if (splits_first(na, nb)) {
       for (std::int32_t c = na.first; c < na.first + 2; ++c) {
-        const double d2 = box_distance_squared(ta.nodes_[static_cast<std::size_t>(c)].box, nb.box);
+        const double d2 = node_d2(pr, c, e.node_b);
         if (d2 <= b * b) push({d2, e.pair, c, e.node_b, ta.node_min_ids_[static_cast<std::size_t>(c)]});
       }
     } else {
       for (std::int32_t c = nb.first; c < nb.first + 2; ++c) {
-        const double d2 = box_distance_squared(na.box, tb.nodes_[static_cast<std::size_t>(c)].box);
+        const double d2 = node_d2(pr, e.node_a, c);
         if (d2 <= b * b) push({d2, e.pair, e.node_a, c, e.rank});
       }
     }
