@@ -210,21 +210,11 @@ TEST(CcdPipeline, LayersCloserThanTheObjectsMarginButApartAreCulled) {
 // pair across them is looked at.
 TEST(CcdPipeline, SheetsAslantArePassedOverAlongTheDiagonals) {
   const int n = 10;
-  const Vec3 u = Vec3(1, -1, 0).normalized(), v = Vec3(1, 1, -2).normalized(), normal = Vec3(1, 1, 1).normalized();
+  const Vec3 u = test::AslantFrame{}.u;
   Frame from, to;
-  std::vector<Face> faces;
-  for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x) {
-      const Index a = y * (n + 1) + x, b = a + 1, c = a + n + 1, d = c + 1;
-      faces.push_back({a, b, d});
-      faces.push_back({a, d, c});
-    }
-  for (int sheet = 0; sheet < 2; ++sheet) {
-    std::vector<Vec3> p;
-    for (int y = 0; y <= n; ++y)
-      for (int x = 0; x <= n; ++x) p.push_back(x * u + y * v + sheet * 0.2 * normal);
-    from.objects.push_back(test::make_object(p, faces, sheet == 0 ? "bottom" : "top"));
-  }
+  for (int sheet = 0; sheet < 2; ++sheet)
+    from.objects.push_back(test::make_aslant_sheet(n, sheet * 0.2, sheet == 0 ? "bottom" : "top"));
+  const std::vector<Face>& faces = from.objects[0].topology->faces;
   to.objects = from.objects;
   to.index = 1;
   for (Vec3& x : to.objects[1].positions) x += 0.3 * u;  // the top sheet slides

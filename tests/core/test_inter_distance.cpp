@@ -483,22 +483,12 @@ TEST(InterDistance, SheetsAslantAreCulledAlongTheDiagonals) {
   // the sheets overlap (hundreds of triangle pairs), but the gap along the diagonal (1, 1, 1)
   // bounds their distance by 1, so no pair across them is looked at.
   const int n = 10;
-  const Vec3 u = Vec3(1, -1, 0).normalized(), v = Vec3(1, 1, -2).normalized(), normal = Vec3(1, 1, 1).normalized();
+  const test::AslantFrame w;
+  const Vec3 &u = w.u, &v = w.v, &normal = w.normal;
   Frame frame;
-  std::vector<Face> faces;
-  for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x) {
-      const Index a = y * (n + 1) + x, b = a + 1, c = a + n + 1, d = c + 1;
-      faces.push_back({a, b, d});
-      faces.push_back({a, d, c});
-    }
   const Vec3 middle = 0.5 * n * (u + v);
-  for (int sheet = 0; sheet < 2; ++sheet) {
-    std::vector<Vec3> p;
-    for (int y = 0; y <= n; ++y)
-      for (int x = 0; x <= n; ++x) p.push_back(x * u + y * v + sheet * 1.0 * normal);
-    frame.objects.push_back(test::make_object(p, faces, "sheet" + std::to_string(sheet)));
-  }
+  for (int sheet = 0; sheet < 2; ++sheet)
+    frame.objects.push_back(test::make_aslant_sheet(n, sheet * 1.0, "sheet" + std::to_string(sheet)));
   for (int sheet = 0; sheet < 2; ++sheet) {
     const Vec3 c = middle + (sheet == 0 ? -0.1 : 1.1) * normal;
     frame.objects.push_back(test::make_object({c, c + 0.3 * u, c + 0.3 * v}, {Face{0, 1, 2}}, "near" + std::to_string(sheet)));

@@ -242,19 +242,13 @@ TEST(IntraDistance, SheetsAslantAreCulledAlongTheDiagonals) {
   // but the gap along the diagonal (1, 1, 1) bounds their distance, so few pairs across them
   // become candidates: 52 (without the diagonals, 5,628; and 7,892 in all against 1,740).
   const int n = 10;
-  const Vec3 u = Vec3(1, -1, 0).normalized(), v = Vec3(1, 1, -2).normalized(), normal = Vec3(1, 1, 1).normalized();
   std::vector<Vec3> p;
   std::vector<Face> faces;
   for (int sheet = 0; sheet < 2; ++sheet) {
+    const Object o = test::make_aslant_sheet(n, sheet * 1.0, "sheet");
     const Index base = static_cast<Index>(p.size());
-    for (int y = 0; y <= n; ++y)
-      for (int x = 0; x <= n; ++x) p.push_back(x * u + y * v + sheet * 1.0 * normal);
-    for (int y = 0; y < n; ++y)
-      for (int x = 0; x < n; ++x) {
-        const Index a = base + y * (n + 1) + x, b = a + 1, c = a + n + 1, d = c + 1;
-        faces.push_back({a, b, d});
-        faces.push_back({a, d, c});
-      }
+    p.insert(p.end(), o.positions.begin(), o.positions.end());
+    for (const Face& f : o.topology->faces) faces.push_back({f[0] + base, f[1] + base, f[2] + base});
   }
   const Frame both = frame_of({test::make_object(p, faces, "two sheets")});
   const auto got = intra_object_distance(both, {1});

@@ -26,6 +26,30 @@ inline Object make_object(std::vector<Vec3> positions, std::vector<Face> faces, 
   return o;
 }
 
+/// Directions of the sheets of make_aslant_sheet(): two in its plane (u, v) and its normal,
+/// (1, 1, 1) normalised.
+struct AslantFrame {
+  Vec3 u = Vec3(1, -1, 0).normalized(), v = Vec3(1, 1, -2).normalized(), normal = Vec3(1, 1, 1).normalized();
+};
+
+/// A flat n x n grid sheet of unit squares (two triangles each) spanned by AslantFrame's u and
+/// v from the origin, moved `offset` along its normal: lying aslant to every axis, so that
+/// sheets side by side have overlapping boxes but stay apart along the diagonal (1, 1, 1).
+inline Object make_aslant_sheet(int n, double offset, const std::string& name) {
+  const AslantFrame w;
+  std::vector<Vec3> p;
+  for (int y = 0; y <= n; ++y)
+    for (int x = 0; x <= n; ++x) p.push_back(x * w.u + y * w.v + offset * w.normal);
+  std::vector<Face> faces;
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const Index a = y * (n + 1) + x, b = a + 1, c = a + n + 1, d = c + 1;
+      faces.push_back({a, b, d});
+      faces.push_back({a, d, c});
+    }
+  return make_object(std::move(p), std::move(faces), name);
+}
+
 /// A regular nx x ny grid sheet of side `cell` (two triangles per square, diagonals alternating)
 /// folded over onto itself around a half cylinder of radius gap / 2 at arc length `fold`: the
 /// two layers face each other `gap` apart, so nearest non-adjacent triangles are across the
