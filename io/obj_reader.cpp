@@ -7,7 +7,6 @@
 #include <limits>
 #include <string>
 #include <string_view>
-#include <utility>
 
 namespace vproxq::io_detail {
 
@@ -63,14 +62,24 @@ class ObjParser {
       line_no_ = line_no;
       parse_line(line);
     });
-    // Positive face indices may name vertices defined further down; those beyond the vertices
-    // read so far were noted, and are checked now that the count is known (the first such line).
-    for (const auto& [line_no, idx] : forward_)
-      if (idx > static_cast<long long>(positions_.size())) {
-        line_no_ = line_no;
-        fail("face index " + std::to_string(idx) + " out of range (file has " +
-             std::to_string(positions_.size()) + " vertices)");
-      }
+    // Positive face indices may name vertices defined further down; the largest beyond the
+    // vertices read so far is checked now that the count is known. Past it, the lines are read
+    // again for the first such index, to name it (the file has been parsed once: its face
+    // lines are well formed).
+    if (largest_forward_ > static_cast<long long>(positions_.size())) {
+      for_each_line(text_, [this](long line_no, std::string_view line) {
+        std::string_view rest = line;
+        if (next_token(rest) != "f") return;
+        for (std::string_view tok = next_token(rest); !tok.empty() && !is_comment(tok); tok = next_token(rest)) {
+          long long idx = 0;
+          if (parse_integer(tok.substr(0, tok.find('/')), idx) && idx > static_cast<long long>(positions_.size())) {
+            line_no_ = line_no;
+            fail("face index " + std::to_string(idx) + " out of range (file has " +
+                 std::to_string(positions_.size()) + " vertices)");
+          }
+        }
+      });
+    }
   }
 
   std::vector<MeshGroup> result(ObjGroups mode) {
@@ -227,10 +236,8 @@ class ObjParser {
     if (count == 2 && parts[1].empty()) fail("malformed face corner: empty texture index");
     if (idx == 0) fail("face index 0 is invalid (OBJ indices start at 1)");
     if (idx > 0) {
-      if (idx > static_cast<long long>(positions_.size())) {
-        // A vertex further down, or none: parse() checks once the file's count is known.
-        forward_.emplace_back(line_no_, idx);
-      }
+      // A vertex further down, or none: parse() checks once the file's count is known.
+      largest_forward_ = std::max(largest_forward_, idx);
       return static_cast<Index>(idx - 1);
     }
     const long long resolved = static_cast<long long>(positions_.size()) + idx;
@@ -259,7 +266,7 @@ class ObjParser {
   const fs::path& file_;
   const std::string& text_;
   long line_no_ = 0;
-  std::vector<std::pair<long, long long>> forward_;  ///< (line, index) past the vertices read
+  long long largest_forward_ = 0;  ///< the largest positive face index
   std::vector<Vec3> positions_;
   std::vector<RawGroup> groups_;
   std::vector<Index> corners_;
