@@ -42,6 +42,10 @@ struct FrameBoxes {
   static constexpr std::size_t kLargeBvh = 4096;
   /// The BVH of the boxes of the objects with triangles, built on first use (like bvh()).
   const ObjectBoxTree& object_tree() const;
+  /// Object i's projections onto the diagonals, per triangle and per node of bvh(i) (frame:
+  /// the frame these boxes are of), computed on first use (like bvh()) and then shared by the
+  /// inter- and intra-object distance.
+  const HierarchyDiagonals& diagonals(const Frame& frame, std::size_t i) const;
 
   struct BvhCache;
   std::shared_ptr<BvhCache> bvh_cache;  ///< set by compute()
@@ -56,7 +60,8 @@ struct Enclosure {
 };
 
 struct FrameBoxes::BvhCache {
-  explicit BvhCache(std::size_t n) : once(n), bvhs(n), enclosure_once(n), enclosures(n) {}
+  explicit BvhCache(std::size_t n)
+      : once(n), bvhs(n), enclosure_once(n), enclosures(n), diagonals_once(n), diagonals(n) {}
   std::vector<std::once_flag> once;
   std::vector<TriangleBvh> bvhs;
   std::once_flag object_once;
@@ -64,11 +69,22 @@ struct FrameBoxes::BvhCache {
   /// Computed on first use (enclosure_lower_bound()): only pairs whose boxes overlap need them.
   std::vector<std::once_flag> enclosure_once;
   std::vector<Enclosure> enclosures;
+  std::vector<std::once_flag> diagonals_once;
+  std::vector<HierarchyDiagonals> diagonals;
 };
 
 inline const TriangleBvh& FrameBoxes::bvh(std::size_t i) const {
   std::call_once(bvh_cache->once[i], [&] { bvh_cache->bvhs[i].build(triangles[i]); });
   return bvh_cache->bvhs[i];
+}
+
+inline const HierarchyDiagonals& FrameBoxes::diagonals(const Frame& frame, std::size_t i) const {
+  std::call_once(bvh_cache->diagonals_once[i], [&] {
+    HierarchyDiagonals& d = bvh_cache->diagonals[i];
+    d.triangles = triangle_diagonals(frame.objects[i]);
+    d.nodes = node_diagonals(bvh(i), d.triangles);
+  });
+  return bvh_cache->diagonals[i];
 }
 
 template <typename Want>

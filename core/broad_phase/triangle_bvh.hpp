@@ -386,13 +386,9 @@ class TriangleBvh::PairSearch {
   }
   /// The same where distances are also bounded by the projections onto the diagonals: per
   /// hierarchy, those of its nodes and triangles (HierarchyDiagonals). Boxes' squared
-  /// distances are raised to gap^2 / 3 (diagonal_gap()) where that is larger, for the order,
-  /// the bound and the d2 passed to visit alike; the caller's bound must carry a slack above
-  /// the projections' rounding (a few 2^-53 of the largest coordinate).
-  struct HierarchyDiagonals {
-    std::vector<Diagonals> nodes;      ///< per node (node_diagonals())
-    std::vector<Diagonals> triangles;  ///< per triangle id
-  };
+  /// distances are raised (raised_distance_squared()), for the order, the bound and the d2
+  /// passed to visit alike; the caller's bound must carry a slack above the projections'
+  /// rounding (a few 2^-53 of the largest coordinate).
   std::size_t add(const TriangleBvh& a, const TriangleBvh& b, double bound, const HierarchyDiagonals* da,
                   const HierarchyDiagonals* db) {
     const std::size_t p = pairs_.size();
@@ -419,14 +415,10 @@ class TriangleBvh::PairSearch {
     const HierarchyDiagonals* da;  ///< both null, or both set
     const HierarchyDiagonals* db;
   };
-  static double raise(double d2, const Diagonals& x, const Diagonals& y) {
-    const double gap = diagonal_gap(x, y);
-    return std::max(d2, gap * gap / 3);
-  }
   static double node_d2(const Pair& p, std::int32_t na, std::int32_t nb) {
     const auto ua = static_cast<std::size_t>(na), ub = static_cast<std::size_t>(nb);
     const double d2 = box_distance_squared(p.a->nodes_[ua].box, p.b->nodes_[ub].box);
-    return p.da ? raise(d2, p.da->nodes[ua], p.db->nodes[ub]) : d2;
+    return p.da ? raised_distance_squared(d2, p.da->nodes[ua], p.db->nodes[ub]) : d2;
   }
   struct Entry {
     double d2;
@@ -474,7 +466,8 @@ void TriangleBvh::PairSearch::run(const Bound& bound, const KeepNode& keep_node,
         for (std::int32_t k = nb.first; k < nb.first + nb.count; ++k) {
           const Index u = tb.order_[static_cast<std::size_t>(k)];
           double d2 = box_distance_squared(box, tb.leaf_boxes_[static_cast<std::size_t>(k)]);
-          if (pr.da) d2 = raise(d2, pr.da->triangles[static_cast<std::size_t>(t)], pr.db->triangles[static_cast<std::size_t>(u)]);
+          if (pr.da)
+            d2 = raised_distance_squared(d2, pr.da->triangles[static_cast<std::size_t>(t)], pr.db->triangles[static_cast<std::size_t>(u)]);
           const double bk = bound();
           if (d2 <= bk * bk) visit(p, t, u, d2);
         }

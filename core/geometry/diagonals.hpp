@@ -43,6 +43,22 @@ std::vector<Diagonals> node_diagonals(const Bvh& bvh, const std::vector<Diagonal
                         });
 }
 
+/// Per triangle of an object (anything with num_triangles() and triangle(t)), the Diagonals
+/// of its corners.
+template <typename Obj>
+std::vector<Diagonals> triangle_diagonals(const Obj& o) {
+  std::vector<Diagonals> out(static_cast<size_t>(o.num_triangles()));
+  for (Index t = 0; t < o.num_triangles(); ++t)
+    for (const Vec3& x : o.triangle(t)) out[static_cast<size_t>(t)].extend(x);
+  return out;
+}
+
+/// An object's Diagonals per triangle (by id) and per node of its hierarchy (node_diagonals()).
+struct HierarchyDiagonals {
+  std::vector<Diagonals> nodes;
+  std::vector<Diagonals> triangles;
+};
+
 /// The largest gap between the projections of a and b onto one diagonal (0 when they overlap
 /// on all four): divided by sqrt(3), a lower bound on the distance between the two sets (up
 /// to the rounding above: callers compare it with a bound that carries a larger slack).
@@ -50,6 +66,13 @@ inline double diagonal_gap(const Diagonals& a, const Diagonals& b) {
   double gap = 0;
   for (size_t d = 0; d < 4; ++d) gap = std::max({gap, b.lo[d] - a.hi[d], a.lo[d] - b.hi[d]});
   return gap;
+}
+
+/// A squared lower bound `d2` on the distance between two sets (their boxes'), raised to the
+/// square of the diagonal gap / sqrt(3) where that is larger.
+inline double raised_distance_squared(double d2, const Diagonals& a, const Diagonals& b) {
+  const double gap = diagonal_gap(a, b);
+  return std::max(d2, gap * gap / 3);
 }
 
 }  // namespace vproxq

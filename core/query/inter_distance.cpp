@@ -92,7 +92,6 @@ struct SearchScratch {
 /// d <= bound has D_l(f) <= d and D_l(g) <= d (each is at most d from some other object), so
 /// the D_l cuts lose nothing. `u` is D_u(O_i) from Stage I or II.
 void search_object(const Frame& frame, const FrameBoxes& boxes,
-                   const std::vector<TriangleBvh::PairSearch::HierarchyDiagonals>& diagonals,
                    const std::vector<Index>& pns, Index i, double u, double slack,
                    const VoronoiBounds* voronoi, Best& best, SearchScratch& scratch,
                    DistanceCounters& counters) {
@@ -154,7 +153,10 @@ void search_object(const Frame& frame, const FrameBoxes& boxes,
       if (!(low_i && low_i[t] > b) && !best.contact_prunes(j, t) &&
           box_distance_squared(tb_i[static_cast<size_t>(t)], box_j) <= b * b)
         ++counters.feature_pns;
-    scratch.search.add(bvh_i, boxes.bvh(static_cast<size_t>(j)), b, &diagonals[ui], &diagonals[static_cast<size_t>(j)]);
+    // Box distances raised along the diagonals (FrameBoxes::diagonals()): their rounding, a
+    // few 2^-53 of the largest coordinate, is far inside the slack that the bound carries.
+    scratch.search.add(bvh_i, boxes.bvh(static_cast<size_t>(j)), b, &boxes.diagonals(frame, ui),
+                       &boxes.diagonals(frame, static_cast<size_t>(j)));
     scratch.pair_object.push_back(j);
   }
   scratch.search.run(bound, keep_node, keep_triangle, visit);
@@ -182,18 +184,6 @@ InterDistanceOutput inter_object_distance(const Frame& frame, const FrameBoxes& 
   Stopwatch sw;
   out.per_object.resize(n);
   boxes.build_bvhs(threads, [](size_t) { return true; });
-  // Per object, its triangles' and nodes' projections onto the diagonals, which raise the
-  // search's box distances (PairSearch::HierarchyDiagonals). They are off by a few 2^-53 of
-  // the largest coordinate, far inside the slack that every bound below carries.
-  std::vector<TriangleBvh::PairSearch::HierarchyDiagonals> diagonals(n);
-  parallel_for(n, threads, [&](size_t i) {
-    const Object& o = frame.objects[i];
-    auto& d = diagonals[i];
-    d.triangles.resize(static_cast<size_t>(o.num_triangles()));
-    for (Index t = 0; t < o.num_triangles(); ++t)
-      for (const Vec3& x : o.triangle(t)) d.triangles[static_cast<size_t>(t)].extend(x);
-    d.nodes = node_diagonals(boxes.bvh(i), d.triangles);
-  });
   std::vector<DistanceCounters> counters(n);
   parallel_for(n, threads, [&](size_t ui) {
     const Index i = static_cast<Index>(ui);
@@ -208,7 +198,7 @@ InterDistanceOutput inter_object_distance(const Frame& frame, const FrameBoxes& 
     double magnitude = boxes.magnitudes[ui];
     for (Index j : stage1.pns[ui]) magnitude = std::max(magnitude, boxes.magnitudes[static_cast<size_t>(j)]);
     const double slack = rounding_slack(magnitude);
-    search_object(frame, boxes, diagonals, stage1.pns[ui], i, u, slack, opts.voronoi, best, scratch,
+    search_object(frame, boxes, stage1.pns[ui], i, u, slack, opts.voronoi, best, scratch,
                   counters[ui]);
     out.per_object[ui] = to_result(i, best);
   });

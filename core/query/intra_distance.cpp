@@ -194,7 +194,7 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     std::vector<std::array<Index, 3>> common;
     std::vector<double> reach, node_lower;
     std::vector<SeparationSite> sites;  ///< per triangle: its part of separation_lower_bound()
-    std::vector<Diagonals> diagonals, node_diagonals;
+    const HierarchyDiagonals* diagonals = nullptr;  ///< FrameBoxes::diagonals()
     double slack = 0;
   };
   std::vector<ObjectSearch> search(n_obj);
@@ -219,8 +219,9 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     if (a == b) return ca[0] == kNoIndex;
     if (TriangleBvh::adjacent_subtree(ca, s.common[static_cast<size_t>(b)])) return false;
     const TriangleBvh& bvh = boxes.bvh(i);
-    const double gap = diagonal_gap(s.node_diagonals[static_cast<size_t>(a)], s.node_diagonals[static_cast<size_t>(b)]);
-    const double d2 = std::max(box_distance_squared(bvh.node_box(a), bvh.node_box(b)), gap * gap / 3);
+    const double d2 = raised_distance_squared(box_distance_squared(bvh.node_box(a), bvh.node_box(b)),
+                                              s.diagonals->nodes[static_cast<size_t>(a)],
+                                              s.diagonals->nodes[static_cast<size_t>(b)]);
     const double ra = s.reach[static_cast<size_t>(a)], rb = s.reach[static_cast<size_t>(b)];
     const bool lower = !s.node_lower.empty();
     return (d2 <= ra * ra && (!lower || s.node_lower[static_cast<size_t>(b)] <= ra)) ||
@@ -238,10 +239,7 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     s.common = bvh.node_common_vertices(frame.objects[i].topology->faces);
     s.sites.resize(n);
     for (size_t t = 0; t < n; ++t) s.sites[t] = separation_site(frame.objects[i].triangle(static_cast<Index>(t)));
-    s.diagonals.resize(n);
-    for (size_t t = 0; t < n; ++t)
-      for (const Vec3& x : frame.objects[i].triangle(static_cast<Index>(t))) s.diagonals[t].extend(x);
-    s.node_diagonals = node_diagonals(bvh, s.diagonals);
+    s.diagonals = &boxes.diagonals(frame, i);
     // D_u(t): the 2-ring bound, or Stage II's (which already includes it) when smaller.
     s.upper = ring2_bound[i];
     if (voronoi)
@@ -333,8 +331,8 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     boxes.bvh(i).descend_self(tasks[k].pair, [&](std::int32_t a, std::int32_t b) { return enter(i, a, b); },
                               [&](Index t, Index u, const AABB& bt, const AABB& bu) {
       const Index f = std::min(t, u), g = std::max(t, u);
-      const double gap = diagonal_gap(s.diagonals[static_cast<size_t>(f)], s.diagonals[static_cast<size_t>(g)]);
-      const double d2 = std::max(box_distance_squared(bt, bu), gap * gap / 3);
+      const double d2 = raised_distance_squared(box_distance_squared(bt, bu), s.diagonals->triangles[static_cast<size_t>(f)],
+                                                s.diagonals->triangles[static_cast<size_t>(g)]);
       const double bf = bound(static_cast<size_t>(f)), bg = bound(static_cast<size_t>(g));
       if ((d2 > bf * bf && d2 > bg * bg) || shares_vertex(o, f, g)) return;
       if (d2 > 0) {

@@ -410,12 +410,9 @@ TEST(TriangleBvhPairSearch, VisitsExactlyThePairsWithinTheBound) {
   }
   // Per object, the projections onto the diagonals of its triangles and nodes: with them,
   // "within the bound" is of the boxes' squared distance raised to gap^2 / 3.
-  std::vector<TriangleBvh::PairSearch::HierarchyDiagonals> diag(n);
+  std::vector<HierarchyDiagonals> diag(n);
   for (size_t i = 0; i < n; ++i) {
-    for (Index t = 0; t < frame.objects[i].num_triangles(); ++t) {
-      diag[i].triangles.emplace_back();
-      for (const Vec3& x : frame.objects[i].triangle(t)) diag[i].triangles.back().extend(x);
-    }
+    diag[i].triangles = triangle_diagonals(frame.objects[i]);
     diag[i].nodes = node_diagonals(bvhs[i], diag[i].triangles);
   }
   auto pair_d2 = [&](size_t a, Index ta, size_t b, Index tb, bool diagonals) {
