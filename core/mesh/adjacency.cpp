@@ -41,7 +41,7 @@ Adjacency::Adjacency(const Topology& topology) {
   });
 
   // Edges {a, b}, a < b, grouped by b (counting), each group's a sorted and made unique: the
-  // documented (b, a) order. A face's edge k gets its id from its group.
+  // documented (b, a) order. A face's edge k gets its id from its group (find_edge()).
   const IndexRows by_high = counted_rows(nv, [&](auto&& emit) {
     for (const Face& f : faces)
       for (std::size_t k = 0; k < 3; ++k) {
@@ -49,30 +49,21 @@ Adjacency::Adjacency(const Topology& topology) {
         if (a != b) emit(std::max(a, b), std::min(a, b));
       }
   });
-  std::vector<Index> first_edge(nv + 1, 0);  // edges of group b: [first_edge[b], first_edge[b + 1])
+  first_edge_.assign(nv + 1, 0);
   edges_.reserve(by_high.values.size() / 2 + 1);
   std::vector<Index> group;
   for (std::size_t b = 0; b < nv; ++b) {
-    first_edge[b] = static_cast<Index>(edges_.size());
+    first_edge_[b] = static_cast<Index>(edges_.size());
     const IndexSpan row = by_high.row(static_cast<Index>(b));
     group.assign(row.begin(), row.end());
     std::sort(group.begin(), group.end());
     group.erase(std::unique(group.begin(), group.end()), group.end());
     for (const Index a : group) edges_.push_back({a, static_cast<Index>(b)});
   }
-  first_edge[nv] = static_cast<Index>(edges_.size());
-  // A binary search in the group: a hub's group holds thousands (a fan of 20,000 triangles).
-  auto edge_id = [&](Index a, Index b) {
-    if (a == b) return kNoIndex;
-    const Index lo = std::min(a, b), hi = std::max(a, b);
-    const auto first = edges_.begin() + first_edge[static_cast<std::size_t>(hi)];
-    const auto last = edges_.begin() + first_edge[static_cast<std::size_t>(hi) + 1];
-    const auto it = std::lower_bound(first, last, lo, [](const std::array<Index, 2>& e, Index v) { return e[0] < v; });
-    return it != last && (*it)[0] == lo ? static_cast<Index>(it - edges_.begin()) : kNoIndex;  // always found
-  };
+  first_edge_[nv] = static_cast<Index>(edges_.size());
   tri_edges_.assign(nt, {kNoIndex, kNoIndex, kNoIndex});
   for (std::size_t t = 0; t < nt; ++t)
-    for (std::size_t k = 0; k < 3; ++k) tri_edges_[t][k] = edge_id(faces[t][k], faces[t][(k + 1) % 3]);
+    for (std::size_t k = 0; k < 3; ++k) tri_edges_[t][k] = find_edge(faces[t][k], faces[t][(k + 1) % 3]);
   edge_tris_ = counted_rows(edges_.size(), [&](auto&& emit) {
     for (std::size_t t = 0; t < nt; ++t) {
       const auto& e = tri_edges_[t];
@@ -180,14 +171,16 @@ IndexSpan Adjacency::ring2_vertices(Index t) const {
   return ring2_vertices_.row(t);
 }
 
+// A binary search in the group of the larger vertex: a hub's group holds thousands of edges
+// (a fan of 20,000 triangles), all of them in the constructor's lookups.
 Index Adjacency::find_edge(Index a, Index b) const {
   if (a == b) return kNoIndex;
-  const std::array<Index, 2> key{std::min(a, b), std::max(a, b)};
-  const auto it = std::lower_bound(edges_.begin(), edges_.end(), key,
-                                   [](const std::array<Index, 2>& e, const std::array<Index, 2>& k) {
-                                     return e[1] < k[1] || (e[1] == k[1] && e[0] < k[0]);
-                                   });
-  return it != edges_.end() && *it == key ? static_cast<Index>(it - edges_.begin()) : kNoIndex;
+  const Index lo = std::min(a, b), hi = std::max(a, b);
+  if (lo < 0 || static_cast<std::size_t>(hi) + 1 >= first_edge_.size()) return kNoIndex;
+  const auto first = edges_.begin() + first_edge_[static_cast<std::size_t>(hi)];
+  const auto last = edges_.begin() + first_edge_[static_cast<std::size_t>(hi) + 1];
+  const auto it = std::lower_bound(first, last, lo, [](const std::array<Index, 2>& e, Index v) { return e[0] < v; });
+  return it != last && (*it)[0] == lo ? static_cast<Index>(it - edges_.begin()) : kNoIndex;
 }
 
 const Adjacency& adjacency(const Topology& topology) {

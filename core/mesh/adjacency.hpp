@@ -98,6 +98,8 @@ class Adjacency {
  private:
   IndexRows vertex_tris_;
   std::vector<std::array<Index, 2>> edges_;
+  /// The edges {a, b} with b the larger vertex: edges_[first_edge_[b], first_edge_[b + 1]).
+  std::vector<Index> first_edge_;
   std::vector<std::array<Index, 3>> tri_edges_;
   IndexRows edge_tris_;
   std::vector<Face> faces_;
