@@ -108,7 +108,7 @@ struct IntersectingPair {
   }
 };
 
-/// Outcome of the local penetration depth of one object pair (README, "Penetration depth").
+/// Outcome of the local penetration depth of one object pair (docs/algorithms.md, "Local penetration depth").
 enum class PdStatus : std::uint8_t {
   Ok = 0,             ///< depth and direction computed
   OpenSurface = 1,    ///< an object has a boundary edge (used by one face): no inside
@@ -118,7 +118,7 @@ enum class PdStatus : std::uint8_t {
   Shallow = 5,        ///< no vertex lies strictly inside the other object and no overlapping
                       ///< triangle has a normal (all degenerate): no direction to measure along
   SelfIntersection = 6,  ///< a self-intersection whose sheets the method cannot tell apart
-                         ///< (README): no number
+                         ///< (docs/algorithms.md): no number
 };
 
 /// Stable text of a PdStatus (JSON "status", README).
@@ -135,7 +135,7 @@ inline const char* pd_status_name(PdStatus s) {
   return "unknown";
 }
 
-/// Why a self-intersection entry has no number (status SelfIntersection; README, "Where it
+/// Why a self-intersection entry has no number (status SelfIntersection; docs/algorithms.md, "Where it
 /// gives no number"): the first of the undecided tests that stopped its contact.
 enum class PdReason : std::uint8_t {
   None = 0,

@@ -79,7 +79,7 @@ class TriangleBvh {
   /// nodes whose boxes overlap is split (the one with the larger box; within one node, into
   /// its children's three pairs), without entering a pair (x, y) for which skip(x, y) is true
   /// (x == y: the pairs within x). Within one object, this replaces a search per triangle:
-  /// neighbouring triangles share the upper levels (README, "Continuous collision detection").
+  /// neighbouring triangles share the upper levels (docs/algorithms.md, "Continuous collision detection").
   template <typename Skip, typename Visit>
   void self_overlaps(const NodePair& pair, const Skip& skip, const Visit& visit) const;
   /// The node pairs that self_overlaps() from the root, (0, 0), goes through first, expanded
@@ -371,7 +371,7 @@ std::vector<TriangleBvh::NodePair> TriangleBvh::self_pairs_below(std::int32_t ma
 /// first), then by node; so the search is deterministic. clear() keeps the allocations.
 ///
 /// Descending a's hierarchy too, rather than each triangle of a into b's on its own, shares
-/// the upper levels among neighbouring triangles: see README, "Inter-object distance".
+/// the upper levels among neighbouring triangles: see docs/algorithms.md, "Inter-object distance".
 class TriangleBvh::PairSearch {
  public:
   void clear() {

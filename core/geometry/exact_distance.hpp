@@ -1,7 +1,7 @@
 #pragma once
 // Exact squared point-triangle distances, to decide what double precision cannot: which of
 // two distances is smaller when they are equal or within rounding of each other (penetration
-// depth's deepest vertex and its nearest face, README "Local penetration depth"). Every double
+// depth's deepest vertex and its nearest face, docs/algorithms.md, "Local penetration depth"). Every double
 // is a dyadic rational m * 2^k, and so is every sum, difference and product of them; the
 // squared distance is a quotient of two such numbers. They are computed here in arbitrary
 // precision: double expansions would overflow, since the coordinates reach 2^200 and a

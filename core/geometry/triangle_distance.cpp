@@ -36,7 +36,7 @@
 // other candidate is evaluated as before, in the same order, so the result is bitwise that of
 // the search over all 15 (detail::triangle_distance_unpruned(), the twin the tests compare
 // it with). A triangle whose vertex candidates are all skipped is not prepared at all. On the
-// pairs of the intra-object distance about 4.6 of the 15 are evaluated (README, "Exactness").
+// pairs of the intra-object distance about 4.6 of the 15 are evaluated (docs/algorithms.md, "Exactness").
 #include "core/geometry/triangle_distance.hpp"
 
 #include <algorithm>

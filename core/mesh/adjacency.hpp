@@ -9,7 +9,7 @@
 // What the 2-ring bound needs per frame, the 2-ring's vertices, is cached (ring2_vertices()),
 // walked around such hubs.
 //
-// Behaviour on irregular meshes (documented in the README):
+// Behaviour on irregular meshes (documented in docs/algorithms.md, "Intra-object distance"):
 //  - boundary and non-manifold edges: an edge simply lists every triangle that uses it (1, 2
 //    or more); rings are defined by shared vertices, so nothing needs a manifold;
 //  - duplicate triangles (same three vertices) share all their vertices, so each is in the

@@ -847,7 +847,7 @@ CcdStepResult continuous_collisions(const Frame& from, const Frame& to, const Cc
   // pairs within objects (between objects it rules out 0-34 there), and leaving those pairs
   // out takes the voxelized triangles per step from 713 to 572 (skirt), 1,797 to 76
   // (cloth-ball), 634 to 89 (bowl), 7,419 to 975 (funnel) and 1,108 to 1,058 (breaking).
-  // README, "Continuous collision detection", has the times.
+  // docs/algorithms.md, "Continuous collision detection", has the times.
   const CcdVoxelCulling* voxels = opts.voxels;
   const bool stage2 = voxels || opts.voxel_backend;
   struct Candidate {

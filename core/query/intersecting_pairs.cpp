@@ -72,7 +72,7 @@ IntersectingPairsOutput intersecting_pairs(const Frame& frame, const FrameBoxes&
   boxes.build_bvhs(threads, [&](size_t i) { return needs_bvh[i] != 0; });
   // Within an object, the hierarchy descends itself (TriangleBvh::descend_self_until()):
   // neighbouring triangles share the upper levels, where a search per triangle from the root
-  // went through them once for each (README, "Intersecting pairs": 1.3-2.3x less time). A pair
+  // went through them once for each (docs/algorithms.md, "Intersecting pairs": 1.3-2.3x less time). A pair
   // of subtrees all of whose triangles share one vertex holds no candidate (thousands of
   // triangles around one vertex overlap each other's boxes there).
   std::vector<std::vector<std::array<Index, 3>>> common(n);

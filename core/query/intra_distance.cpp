@@ -187,7 +187,7 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
   // D_u, the common vertices of each node's triangles, per node the largest reach of its
   // triangles (D_u plus the rounding slack) and, with Stage II, their smallest D_l; and each
   // triangle's part of the separation bound (SeparationSite), computed once instead of in
-  // each of its candidate pairs (README, "Exactness").
+  // each of its candidate pairs (docs/algorithms.md, "Exactness").
   struct ObjectSearch {
     std::unique_ptr<SharedPairs> pairs;
     std::vector<double> upper;

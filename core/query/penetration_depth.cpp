@@ -577,7 +577,7 @@ int compare_distances(double da, LazyExact& a, double db, LazyExact& b, double s
 
 /// The slack of compare_distances for points and triangles of objects whose coordinates are
 /// at most `scale` in magnitude: 2^-40 scale, thousands of times the 16 e*scale that bounds
-/// the error of a computed point-triangle distance (README, "Exactness"), so that two computed
+/// the error of a computed point-triangle distance (docs/algorithms.md, "Exactness"), so that two computed
 /// distances more than the slack apart are ordered as the exact ones are.
 double pd_slack(double scale) { return 0x1p-40 * scale; }
 
@@ -911,7 +911,7 @@ PenetrationDepth self_contact_depth(SelfContext& ctx, Index object, const std::v
       // R(C)'s intersecting triangles: the curve's way across an edge can also reach a
       // triangle that intersects nothing listed (it meets the other sheet only where it shares
       // a vertex with it, e.g. along a box edge a vertex was moved onto), which is no
-      // overlapping triangle (README, step 2).
+      // overlapping triangle (docs/algorithms.md, "Local penetration depth", step 2).
       std::vector<Index> bounding;
       std::copy_if(region_hits[c].begin(), region_hits[c].end(), std::back_inserter(bounding), is_hit);
       std::set_union(touching[c].begin(), touching[c].end(), bounding.begin(), bounding.end(),

@@ -21,7 +21,7 @@ struct PenetrationDepthOutput {
 };
 
 /// Computes the local PD of every object pair that has intersecting triangles, from the
-/// sorted list `intersecting` (intersecting_pairs()). How (README, "Penetration depth"):
+/// sorted list `intersecting` (intersecting_pairs()). How (docs/algorithms.md, "Local penetration depth"):
 ///  1. Both objects must be closed, manifold and consistently oriented (each edge used by
 ///     exactly two faces, once in each direction), else the status says which it is not:
 ///     the inside test needs a well-defined interior.
@@ -48,7 +48,7 @@ struct PenetrationDepthOutput {
 /// inside one of its faces, next to it) differing from its single-sheet value; T's nearest
 /// point is taken outside the vertex's own sheet, bounded by the intersection curve; the
 /// entry is the deepest contact. Status self_intersection only where that cannot be decided
-/// (penetration_depth.cpp, "Self-intersections", and README).
+/// (penetration_depth.cpp, "Self-intersections", and docs/algorithms.md).
 PenetrationDepthOutput penetration_depth(const Frame& frame, const FrameBoxes& boxes,
                                          const std::vector<IntersectingPair>& intersecting,
                                          const PenetrationDepthOptions& opts);

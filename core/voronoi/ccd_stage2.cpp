@@ -62,8 +62,8 @@ constexpr double kRoomPerRecord = 80;
 /// cover some thousands of voxels each (a small scene far from the origin, where the culling
 /// margin dwarfs the triangles: at 1e12, a given grid of 128 took over 60 s and 19 GB, 200 ran
 /// out of memory; near the origin, 4096 took 12.7 s and 5.2 GB on 200 triangles; then --grid
-/// set this grid too). Finer than the default it costs far more than it saves (README,
-/// "Continuous collision detection"), hence the option of its own.
+/// set this grid too). Finer than the default it costs far more than it saves
+/// (docs/algorithms.md, "Continuous collision detection"), hence the option of its own.
 constexpr double kRoomPerRecordGiven = 64 * kRoomPerRecord;
 
 std::int64_t floor_div(std::int64_t a, std::int64_t b) {  // b > 0

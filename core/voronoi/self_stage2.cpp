@@ -64,7 +64,7 @@ int default_self_grid_resolution(std::int64_t triangles, double longest, double 
   // the grid an edge is ~ extent / sqrt(n / 2), so the cell must shrink like 1 / sqrt(n).
   // sqrt(n) cells along the longest axis (cell ~ 0.7 edge), clamped to [32, 512], keeps Stage
   // II's cost moderate; on the cloth-funnel frame finer grids cull a little more but cost more
-  // than they save (README, "Intra-object distance"). Objects that do not span the grid (a
+  // than they save (docs/algorithms.md, "Intra-object distance"). Objects that do not span the grid (a
   // crowd of small ones) have edges far above extent / sqrt(n): there the cell is not made
   // smaller than 0.7 times the median triangle's box (its longest side), which sqrt(n) cells
   // about match for one surface spanning the grid. 2,000 blobs of 180 triangles: 27.7 samples

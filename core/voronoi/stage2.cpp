@@ -229,7 +229,7 @@ VoronoiBounds compute_voronoi_bounds(const Frame& frame, const FrameBoxes& boxes
     // D_u, and with a band of δ (+ slack) a sample culls one of its triangles only where nothing
     // lies within δ of the voxel centre, which saves few exact tests (Stage III then looks only
     // at touching boxes). So its triangles near another object are not sampled and stay
-    // uncullable (D_l = -inf); the others get near_len as above. See README, "Stage II".
+    // uncullable (D_l = -inf); the others get near_len as above. See docs/algorithms.md, "Stage II".
     const bool touching = stage1.upper_bound[i] == 0;
     // Whether a voxel's centre lies within reach of another object's triangle box, against all
     // of near[i]: the answer does not depend on the triangle, so it is found once per voxel

@@ -25,7 +25,7 @@ namespace vproxq {
 /// units until it culled nothing: skirt's frames 10-12 had 2,743 / 5,443 / 8,948 inter-object
 /// exact tests per frame at --grid 128 / 256 / 512 (off: 9,530); with 2 default cells (the
 /// default grid has 92 cells there) 2,292 / 1,428 / 778, for 26 / 116 / 968 ms of Stage II
-/// instead of 22 / 59 / 208 (see README, "Stage II"); 23 / 71 / 249 ms since the bins are
+/// instead of 22 / 59 / 208 (see docs/algorithms.md, "Stage II"); 23 / 71 / 249 ms since the bins are
 /// twice the cap wide on such grids (stage2.cpp).
 inline constexpr double kMaxInterBandCells = 2.0;
 

@@ -165,7 +165,7 @@ TEST(CcdCli, BackendsGiveIdenticalResultsEqualToBruteForce) {
 }
 
 // --grid is the distance queries' grid and leaves CCD's own alone; --ccd-grid sets CCD's
-// (finer CCD grids cost far more than they saved: README, "Continuous collision detection").
+// (finer CCD grids cost far more than they saved: docs/algorithms.md, "Continuous collision detection").
 TEST(CcdCli, CcdGridIsSetByCcdGridAlone) {
   ScratchDir dir;
   const fs::path scene = write_scene(dir, 3, 4, 3);

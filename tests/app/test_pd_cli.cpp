@@ -172,9 +172,9 @@ TEST(PdSelf, CliWritesTheReasonOfEachSelfIntersectionEntry) {
     // A self entry's two lists, one object's, told apart by `side` only.
     expect_pd_features(h5, "/frames/00000" + std::to_string(k), pd);
   }
-  // What the scene holds (README, "Where it gives no number"): a number on three frames, one
+  // What the scene holds (docs/algorithms.md, "Where it gives no number"): a number on three frames, one
   // pair of sheets the curve does not separate; the independent PD oracle (written from the
-  // README, exact rationals) predicts the same entries, frame 0's at triangles 48 and 53.
+  // docs/algorithms.md, exact rationals) predicts the same entries, frame 0's at triangles 48 and 53.
   EXPECT_EQ(seen, (std::map<std::string, int>{{"ok", 3}, {"sheets_not_separated", 1}}));
   // The terminal summary names the reason and where.
   const auto summary = test::vproxq(quote(scene) + " --queries=pd --threads 2 --frames 0:1");

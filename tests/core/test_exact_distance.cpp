@@ -112,7 +112,7 @@ TEST(ExactPointTriangle, KnownDistances) {
 }
 
 // On random (non-dyadic) points and triangles, needles included, the exact squared distance
-// lies within 16 e*S of point_triangle_distance's (the README's bound, S the largest coordinate
+// lies within 16 e*S of point_triangle_distance's (the bound in docs/algorithms.md, S the largest coordinate
 // magnitude), and two distances whose computed values differ by more than that are ordered as
 // computed.
 TEST(ExactPointTriangle, AgreesWithDoublePrecisionWithinItsError) {

@@ -394,7 +394,7 @@ TEST(PenetrationDepth, DeepestVertexIsTheBruteForceMaxMin) {
 // exactly equally deep, and equally near several faces. Double precision rounds such ties
 // either way (a vertex 0.25 from a face computed 0.24999999999999997 from it lost to another
 // vertex 0.25 from a face computed exactly): the deepest vertex, its nearest point and so T
-// must follow the README's tie rules, decided exactly (an independent exact-rational oracle
+// must follow the tie rules of docs/algorithms.md, decided exactly (an independent exact-rational oracle
 // found 19 entries out of about 2,450 that did not).
 TEST(PenetrationDepth, ExactTiesFollowTheTieRules) {
   test::Rng rng(2024);
@@ -450,7 +450,7 @@ Object literal_box(const Vec3& lo, const Vec3& hi, const std::string& name) {
   return literal_object(corners, kBoxFaces, name);
 }
 
-// The two cases the exact oracle reported, worked out by hand from the README's rules.
+// The two cases the exact oracle reported, worked out by hand from the rules of docs/algorithms.md.
 TEST(PenetrationDepth, ExactTiesOfTheOracle) {
   {  // one inside vertex, b's corner 3 = (1.75, 1.25, 1.5), exactly 0.5 from a's faces 1
      // (x = 2.25), 7 (y = 0.75), 8 (z = 2) and 10 (z = 1): the nearest point is on face 1,
@@ -920,7 +920,7 @@ TEST(PenetrationDepthSelf, OverlappingTrianglesIntersectOrTouchAnInsideVertex) {
   // vertices pushed down to z = -1/4 through the bottom, and the top rim's vertex (0.25, 0, 1)
   // moved onto the box edge x = y = 0 at z = 0.75. Triangle 57, (0, 0, 0.5), (0.25, 0, 0.5),
   // (0, 0, 0.75), then meets face 19 of the other sheet along that edge, where the two share a
-  // vertex (no intersecting pair), and was listed as overlapping; README step 2 lists only the
+  // vertex (no intersecting pair), and was listed as overlapping; docs/algorithms.md step 2 lists only the
   // intersecting triangles and those touching an inside vertex.
   const std::vector<int> quarters = {  // x, y, z of each vertex, times 4
       4, 0, 0, 4, 0, 2, 4, 0, 4, 4, 1, 0, 4, 1, 2, 4, 1, 4, 4, 2, 0, 4, 2, 2, 4, 2, 4, 4, 3, 0,

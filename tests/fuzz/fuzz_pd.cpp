@@ -10,8 +10,8 @@
 //    and is too_deep exactly where a connected set of them has no outside neighbour; with
 //    status ok: a unit direction, a depth no narrower than the inside vertices' extent
 //    along it, and the deepest vertex and its nearest point of the exact max-min over every
-//    face (the README's tie rules); no deepest vertex only when no vertex is inside;
-//  - the twin (README, "Self-intersections": for two objects merged into one, the inside test
+//    face (the tie rules of docs/algorithms.md); no deepest vertex only when no vertex is inside;
+//  - the twin (docs/algorithms.md, "Self-intersections": for two objects merged into one, the inside test
 //    is exactly the inter-object one at every vertex whose star does not pass through itself;
 //    such a vertex is not exempted here, so a jittered shape with one inside would show as a
 //    difference): where neither object intersects itself and their
@@ -147,7 +147,7 @@ std::vector<PenetrationDepth> run_pd(const Frame& frame, const std::vector<Inter
   return penetration_depth(frame, boxes, pairs, PenetrationDepthOptions{threads}).pairs;
 }
 
-/// Number of contacts of the pairs (README: pairs linked by a shared triangle or by triangles
+/// Number of contacts of the pairs (docs/algorithms.md: pairs linked by a shared triangle or by triangles
 /// sharing a vertex), each pair's triangles as given by `faces_of`.
 template <class Faces>
 size_t count_contacts(const std::vector<IntersectingPair>& pairs, Faces faces_of) {

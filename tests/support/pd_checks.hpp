@@ -22,7 +22,7 @@
 namespace vproxq::test {
 
 /// The deepest vertex of an entry between two objects by brute force in exact arithmetic, as
-/// the README defines it: each inside vertex's exact distance to every triangle of the other
+/// docs/algorithms.md defines it: each inside vertex's exact distance to every triangle of the other
 /// object (its nearest point on the lowest-numbered of equally near triangles), the largest of
 /// them (ties: objects[0]'s vertices first, then the smallest vertex id). For speed, only
 /// triangles (and vertices) whose double-precision distance is within a margin of the nearest
@@ -123,7 +123,7 @@ inline size_t expect_inside_is_walk_closure(const Frame& frame, const Penetratio
 }
 
 /// Whether some connected set of an entry's listed inside vertices (on either side, connected
-/// through shared triangles) has no neighbour outside the list: the README's too_deep. With the
+/// through shared triangles) has no neighbour outside the list: docs/algorithms.md's too_deep. With the
 /// list the walk closure (expect_inside_is_walk_closure), a neighbour not listed is outside.
 inline bool has_swallowed_set(const Frame& frame, const PenetrationDepth& e) {
   for (int side = 0; side < 2; ++side) {
@@ -157,7 +157,7 @@ inline bool has_swallowed_set(const Frame& frame, const PenetrationDepth& e) {
 }
 
 /// An entry has a reason exactly when it is self_intersection, and the reason's feature has
-/// the property it names (README, "Where it gives no number"): degenerate_star, a vertex of
+/// the property it names (docs/algorithms.md, "Where it gives no number"): degenerate_star, a vertex of
 /// the object all of whose faces are degenerate; flat_fold, a vertex two of whose faces lie in
 /// one plane; reference_vertex, the lexicographically largest vertex (x, y, z, then id) of its
 /// mesh component; sheets_not_separated, an intersecting pair of the object; whole_object,

@@ -275,7 +275,7 @@ SlabPair make_slab_pair(Pick&& pick) {
 }
 
 /// Tolerance of the checks, in units of e * S (e = 2^-53): the distance primitives promise a
-/// few (README, "Exactness"); tests/core/test_triangle_distance.cpp uses the same 16.
+/// few (docs/algorithms.md, "Exactness"); tests/core/test_triangle_distance.cpp uses the same 16.
 inline constexpr double kSlabTolUlps = 16.0;
 
 /// The exact distance between a feature of A and a feature of B given as corner sets (bit i:
