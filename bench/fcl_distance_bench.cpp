@@ -17,6 +17,7 @@
 // over --fcl-threads threads (default: --threads), one object per task, so that both sides get
 // the same cores. The per-object distances of the two must agree within a relative 1e-6;
 // every disagreement is printed and makes the exit status 1.
+#include "app/allocator.hpp"
 #include "bench/bench_common.hpp"
 #include "core/errors.hpp"
 #include "core/broad_phase/object_broad_phase.hpp"
@@ -433,6 +434,7 @@ int run(const Options& opt) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  vproxq::keep_freed_memory_for_reuse();  // as vproxq does
   CLI::App app{"vproxq-bench-fcl: times vproxq's inter-object distance against FCL " FCL_VERSION
                " (BVHModel<OBBRSS> per object + DynamicAABBTree broad phase), frame by frame, "
                "and checks that the two agree."};

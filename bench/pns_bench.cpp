@@ -24,6 +24,7 @@
 //             the whole PNS.
 // All counts include the rounding slack vproxq adds to every bound (rounding_slack()), as
 // Stage III does. The answers of the off and cpu runs are compared (they must be identical).
+#include "app/allocator.hpp"
 #include "bench/bench_common.hpp"
 #include "core/broad_phase/object_broad_phase.hpp"
 #include "core/broad_phase/triangle_bvh.hpp"
@@ -298,6 +299,7 @@ int run(const Options& opt) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  vproxq::keep_freed_memory_for_reuse();  // as vproxq does
   CLI::App app{"vproxq-bench-pns: counts the exact tests of the inter- and intra-object distance "
                "with and without Stage II, against their floors and the paper's fixed-bound PNS."};
   Options opt;
