@@ -15,10 +15,11 @@ namespace vproxq {
 /// per-triangle tables of some MB (boxes, swept triangles, hierarchies), so each one faulted
 /// their pages in again. Blocks up to 32 MB now come from the heap, and a heap keeps up to
 /// 256 MB free at its top. On the report scenes (40 frames, all queries, 2 threads; README,
-/// "Benchmark report") this took skirt's query time from 41.6 / 41.9 to 33.8 / 34.3 ms per
-/// frame and cloth-ball's from 48.1 / 45.6 to 43.8 / 42.0 (page faults on skirt: 67,543 ->
-/// 6,994); bowl, funnel, breaking and a 900,000-triangle scene of 5,000 blobs stayed within
-/// their run-to-run spread. Peak memory: skirt 40 -> 42 MB, the blobs 1.18 -> 1.20 GB.
+/// "Benchmark report") this took skirt's query time from 41.5 / 41.6 / 40.4 / 39.6 to 37.5 /
+/// 34.2 / 39.2 / 35.0 ms per frame (four alternating runs; page faults about 67,000 -> 6,800)
+/// and cloth-ball's from 48.1 / 45.6 to 43.8 / 42.0; bowl, funnel, breaking and a
+/// 900,000-triangle scene of 5,000 blobs stayed within their run-to-run spread. Peak memory:
+/// skirt 40 -> 42 MB, the blobs 1.18 -> 1.20 GB.
 inline void keep_freed_memory_for_reuse() {
 #if defined(__GLIBC__)
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
