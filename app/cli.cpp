@@ -28,8 +28,15 @@ namespace {
 
 const char* kDescription =
     "vproxq: exact proximity queries on animated triangle meshes.\n"
-    "For every frame of SCENE (a scene.json or a single mesh file) and every object: the\n"
-    "nearest other object, the separation distance and the closest triangle pair.\n"
+    "For every frame of SCENE (a scene.json or a single mesh file), in double precision and\n"
+    "equal to brute force:\n"
+    "  distance  each object's nearest other object (distance, closest triangles and points),\n"
+    "            each triangle's nearest non-adjacent triangle of its own object, and every\n"
+    "            intersecting triangle pair\n"
+    "  ccd       every vertex-face and edge-edge pair that collides between this frame and the\n"
+    "            next (vertices moving linearly), with its earliest time of impact\n"
+    "  pd        the local penetration depth and direction of each intersecting object pair\n"
+    "            and self-intersecting object\n"
     "Exit codes: 0 ok, 2 usage error, 3 input error, 4 runtime error.\n"
     "See also: vproxq diff A.json B.json (compare two result files),\n"
     "          vproxq check-ccd FILE.csv --type vf|ee (check CCD on ground-truth queries).";

@@ -71,6 +71,9 @@ TEST(Cli, HelpAndVersion) {
   EXPECT_NE(r.output.find("--queries Q[,Q...]"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("Valid: distance, ccd, pd"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("Exit codes"), std::string::npos);
+  // What each query answers, one entry per query.
+  for (const char* entry : {"\n  distance  each object's", "\n  ccd       every vertex-face", "\n  pd        the local"})
+    EXPECT_NE(r.output.find(entry), std::string::npos) << entry << "\n" << r.output;
   r = vproxq("--version");
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_NE(r.output.find(VPROXQ_VERSION), std::string::npos);
