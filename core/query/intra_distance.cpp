@@ -331,10 +331,15 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     boxes.bvh(i).descend_self(tasks[k].pair, [&](std::int32_t a, std::int32_t b) { return enter(i, a, b); },
                               [&](Index t, Index u, const AABB& bt, const AABB& bu) {
       const Index f = std::min(t, u), g = std::max(t, u);
-      const double d2 = raised_distance_squared(box_distance_squared(bt, bu), s.diagonals->triangles[static_cast<size_t>(f)],
-                                                s.diagonals->triangles[static_cast<size_t>(g)]);
       const double bf = bound(static_cast<size_t>(f)), bg = bound(static_cast<size_t>(g));
-      if ((d2 > bf * bf && d2 > bg * bg) || shares_vertex(o, f, g)) return;
+      const double reach2 = std::max(bf * bf, bg * bg);
+      // The diagonals only raise the boxes' distance: a pair beyond both bounds by its boxes
+      // is passed over without them.
+      const double box_d2 = box_distance_squared(bt, bu);
+      if (box_d2 > reach2) return;
+      const double d2 = raised_distance_squared(box_d2, s.diagonals->triangles[static_cast<size_t>(f)],
+                                                s.diagonals->triangles[static_cast<size_t>(g)]);
+      if (d2 > reach2 || shares_vertex(o, f, g)) return;
       if (d2 > 0) {
         later.push_back({d2, f, g});
         farthest = std::max(farthest, d2);
