@@ -38,6 +38,29 @@ struct PreparedTriangle {
 /// Computes the PreparedTriangle of t.
 PreparedTriangle prepare_triangle(const Triangle& t);
 
+/// The part of a PreparedTriangle that costs more than its corners' differences (the accurate
+/// normal most): what a search that meets each triangle in many pairs keeps per triangle,
+/// 56 bytes instead of 200.
+struct PreparedTriangleParts {
+  Vec3 normal;
+  double normal_sq;
+  double side_bound[3];
+};
+inline PreparedTriangleParts parts_of(const PreparedTriangle& p) {
+  return {p.normal, p.normal_sq, {p.side_bound[0], p.side_bound[1], p.side_bound[2]}};
+}
+/// prepare_triangle(t), bitwise, from parts_of(prepare_triangle(t)): the corners and edges are
+/// computed as prepare_triangle() computes them.
+inline PreparedTriangle prepared_from_parts(const Triangle& t, const PreparedTriangleParts& parts) {
+  PreparedTriangle p;
+  p.corners = t;
+  for (int k = 0; k < 3; ++k) p.edges[k] = t[static_cast<size_t>((k + 1) % 3)] - t[static_cast<size_t>(k)];
+  p.normal = parts.normal;
+  p.normal_sq = parts.normal_sq;
+  for (int k = 0; k < 3; ++k) p.side_bound[k] = parts.side_bound[k];
+  return p;
+}
+
 /// Distance from p to the closed triangle t (any shape).
 ///
 /// When the orthogonal projection of p onto the triangle's plane falls inside the triangle,

@@ -74,9 +74,42 @@ constexpr double kPruneMargin = 0x1p-30;
 /// The box of a segment's corners.
 inline AABB segment_box(const Vec3& p, const Vec3& q) { return {p.cwiseMin(q), p.cwiseMax(q)}; }
 
-/// The 15-candidate search, with or without pruning (see the top of the file).
-template <bool kPrune>
-TriangleDistanceResult search(const Triangle& a, const Triangle& b) {
+/// The closest points of r's winning feature pair (r from search(), not intersecting), from
+/// the stand-alone primitive: its squared distance is the one the search found, bitwise.
+/// pre_a, pre_b: the prepared triangles, or null (then prepared here when needed).
+void add_points(TriangleDistanceResult& r, const Triangle& a, const PreparedTriangle* pre_a, const Triangle& b,
+                const PreparedTriangle* pre_b) {
+  switch (r.kind) {
+    case TriangleDistanceCase::Intersecting:
+      return;  // the common point is set already
+    case TriangleDistanceCase::VertexFace: {
+      const Vec3& p = a[static_cast<size_t>(r.feature_a)];
+      r.point_a = p;
+      r.point_b = (pre_b ? point_triangle_distance(p, *pre_b) : point_triangle_distance(p, b)).closest;
+      return;
+    }
+    case TriangleDistanceCase::FaceVertex: {
+      const Vec3& p = b[static_cast<size_t>(r.feature_b)];
+      r.point_a = (pre_a ? point_triangle_distance(p, *pre_a) : point_triangle_distance(p, a)).closest;
+      r.point_b = p;
+      return;
+    }
+    case TriangleDistanceCase::EdgeEdge: {
+      const int ea = r.feature_a, eb = r.feature_b;
+      const SegmentSegmentResult e = segment_segment_distance(a[static_cast<size_t>(ea)], a[static_cast<size_t>((ea + 1) % 3)],
+                                                              b[static_cast<size_t>(eb)], b[static_cast<size_t>((eb + 1) % 3)]);
+      r.point_a = e.point_a;
+      r.point_b = e.point_b;
+      return;
+    }
+  }
+}
+
+/// The 15-candidate search, with or without pruning (see the top of the file); with kPoints,
+/// the winner's points too. pre_a, pre_b: the triangles prepared by the caller, or null.
+template <bool kPrune, bool kPoints>
+TriangleDistanceResult search(const Triangle& a, const Triangle& b, const PreparedTriangle* pre_a,
+                              const PreparedTriangle* pre_b) {
   TriangleDistanceResult r;
   const IntersectionResult hit = triangle_intersection(a, b);
   if (hit.intersecting) {
@@ -132,23 +165,23 @@ TriangleDistanceResult search(const Triangle& a, const Triangle& b) {
   }
   auto skipped = [&](const AABB& p, const AABB& q) { return kPrune && box_distance_squared(p, q) > limit; };
   auto apart = [&](double a_hi, double b_lo) { return kPrune && b_lo - a_hi > wlimit; };
-  // Each triangle is prepared when a vertex candidate against it is evaluated first.
+  // Each triangle is prepared when a vertex candidate against it is evaluated first (unless
+  // the caller prepared it: prepare_triangle() is deterministic, so that is the same).
   PreparedTriangle prepared_a, prepared_b;
-  bool have_a = false, have_b = false;
-  auto prepared = [](const Triangle& t, PreparedTriangle& p, bool& have) -> const PreparedTriangle& {
-    if (!have) {
+  auto prepared = [](const Triangle& t, PreparedTriangle& p, const PreparedTriangle*& have) -> const PreparedTriangle& {
+    if (have == nullptr) {
       p = prepare_triangle(t);
-      have = true;
+      have = &p;
     }
-    return p;
+    return *have;
   };
   for (int i = 0; i < 3; ++i) {
     if (apart(pa[i], pb_min) || skipped({a[i], a[i]}, box_b)) continue;
-    offer(point_triangle_squared(detail::plan_point_triangle(a[i], prepared(b, prepared_b, have_b)), a_to_b[i]), i);
+    offer(point_triangle_squared(detail::plan_point_triangle(a[i], prepared(b, prepared_b, pre_b)), a_to_b[i]), i);
   }
   for (int j = 0; j < 3; ++j) {
     if (apart(pa_max, pb[j]) || skipped({b[j], b[j]}, box_a)) continue;
-    offer(point_triangle_squared(detail::plan_point_triangle(b[j], prepared(a, prepared_a, have_a)), b_to_a[j]),
+    offer(point_triangle_squared(detail::plan_point_triangle(b[j], prepared(a, prepared_a, pre_a)), b_to_a[j]),
           kFirstFaceVertex + j);
   }
   for (int ea = 0; ea < 3; ++ea) {
@@ -172,30 +205,19 @@ TriangleDistanceResult search(const Triangle& a, const Triangle& b) {
     r.distance = std::numeric_limits<double>::quiet_NaN();
     return r;
   }
-  // Points of the winner only, from the stand-alone primitive (its squared distance is the
-  // one found above, bitwise).
-  if (winner < kFirstFaceVertex) {  // evaluated, so its triangle is prepared
-    r.point_a = a[winner];
-    r.point_b = point_triangle_distance(a[winner], prepared_b).closest;
+  if (winner < kFirstFaceVertex) {
     r.kind = TriangleDistanceCase::VertexFace;
     r.feature_a = static_cast<std::int8_t>(winner);
   } else if (winner < kFirstEdgeEdge) {
-    const int j = winner - kFirstFaceVertex;
-    r.point_a = point_triangle_distance(b[j], prepared_a).closest;
-    r.point_b = b[j];
     r.kind = TriangleDistanceCase::FaceVertex;
-    r.feature_b = static_cast<std::int8_t>(j);
+    r.feature_b = static_cast<std::int8_t>(winner - kFirstFaceVertex);
   } else {
-    const int ea = (winner - kFirstEdgeEdge) / 3;
-    const int eb = (winner - kFirstEdgeEdge) % 3;
-    const SegmentSegmentResult e =
-        segment_segment_distance(a[ea], a[(ea + 1) % 3], b[eb], b[(eb + 1) % 3]);
-    r.point_a = e.point_a;
-    r.point_b = e.point_b;
     r.kind = TriangleDistanceCase::EdgeEdge;
-    r.feature_a = static_cast<std::int8_t>(ea);
-    r.feature_b = static_cast<std::int8_t>(eb);
+    r.feature_a = static_cast<std::int8_t>((winner - kFirstEdgeEdge) / 3);
+    r.feature_b = static_cast<std::int8_t>((winner - kFirstEdgeEdge) % 3);
   }
+  // The winner was evaluated, so the triangle its vertex case needs is prepared.
+  if constexpr (kPoints) add_points(r, a, pre_a, b, pre_b);
   r.distance = std::sqrt(best);
   // Triangles that do not touch can still compute as 0 apart: a gap below about one ulp of
   // their coordinates (a vertex within rounding of the other's plane, say) rounds away in the
@@ -208,11 +230,23 @@ TriangleDistanceResult search(const Triangle& a, const Triangle& b) {
 
 }  // namespace
 
-TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b) { return search<true>(a, b); }
+TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b) {
+  return search<true, true>(a, b, nullptr, nullptr);
+}
+
+TriangleDistanceResult triangle_distance_without_points(const Triangle& a, const PreparedTriangle* pa,
+                                                        const Triangle& b, const PreparedTriangle* pb) {
+  return search<true, false>(a, b, pa, pb);
+}
+
+void add_closest_points(TriangleDistanceResult& r, const Triangle& a, const PreparedTriangle* pa,
+                        const Triangle& b, const PreparedTriangle* pb) {
+  add_points(r, a, pa, b, pb);
+}
 
 namespace detail {
 TriangleDistanceResult triangle_distance_unpruned(const Triangle& a, const Triangle& b) {
-  return search<false>(a, b);
+  return search<false, true>(a, b, nullptr, nullptr);
 }
 }  // namespace detail
 

@@ -1,5 +1,6 @@
 #pragma once
 // Exact-as-double triangle–triangle distance with closest points and the winning feature case.
+#include "core/geometry/point_triangle.hpp"
 #include "core/types.hpp"
 
 #include <utility>
@@ -43,6 +44,18 @@ struct TriangleDistanceResult {
 /// give bitwise equal results. Inputs must be finite; exactness of the intersection decision
 /// holds for coordinates of magnitude in [2^-200, 2^200] or zero (predicates.hpp).
 TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b);
+
+/// triangle_distance() in two steps, for callers that keep few of the pairs they evaluate:
+/// this gives the distance, the case and the features, with the points left at zero (but for
+/// an intersecting pair, whose common point is set); add_closest_points() then fills in the
+/// points of a result that is kept. `pa` and `pb` are prepare_triangle(a) and
+/// prepare_triangle(b) when the caller has them (each triangle of a search met in many pairs
+/// is prepared once), else null. Together, bitwise the numbers of triangle_distance(a, b).
+TriangleDistanceResult triangle_distance_without_points(const Triangle& a, const PreparedTriangle* pa,
+                                                        const Triangle& b, const PreparedTriangle* pb);
+/// Fills in the points of r, from triangle_distance_without_points(a, pa, b, pb).
+void add_closest_points(TriangleDistanceResult& r, const Triangle& a, const PreparedTriangle* pa,
+                        const Triangle& b, const PreparedTriangle* pb);
 
 namespace detail {
 /// triangle_distance() without its pruning: all 15 candidates are evaluated. Bitwise the same

@@ -100,10 +100,14 @@ class SharedPairs {
   /// t's best distance so far (never below its final answer).
   double current(size_t t) const { return current_[t].load(std::memory_order_relaxed); }
 
-  /// Offers t (record `best`) the pair (t, other), r being its evaluation from t's side.
-  void offer(IntraTriangleNearest& best, size_t t, Index other, const TriangleDistanceResult& r) {
+  /// Offers t (record `best`) the pair (t, other) at `distance`; full() gives its whole
+  /// evaluation from t's side (points included), asked for only when the record takes it.
+  template <typename Full>
+  void offer(IntraTriangleNearest& best, size_t t, Index other, double distance, const Full& full) {
     Lock lock(locks_[t]);
-    if (keep_nearer(best, other, r)) current_[t].store(r.distance, std::memory_order_relaxed);
+    if (std::tie(distance, other) >= std::tie(best.distance, best.nearest)) return;
+    keep_nearer(best, other, full());
+    current_[t].store(distance, std::memory_order_relaxed);
   }
 
  private:
@@ -186,14 +190,16 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
   // Per object of at least 2 triangles, what its search reads: the records, each triangle's
   // D_u, the common vertices of each node's triangles, per node the largest reach of its
   // triangles (D_u plus the rounding slack) and, with Stage II, their smallest D_l; and each
-  // triangle's part of the separation bound (SeparationSite), computed once instead of in
-  // each of its candidate pairs (docs/algorithms.md, "Exactness").
+  // triangle's parts of the separation bound (SeparationSite) and of the exact test
+  // (PreparedTriangleParts), computed once instead of in each of its candidate pairs
+  // (docs/algorithms.md, "Exactness").
   struct ObjectSearch {
     std::unique_ptr<SharedPairs> pairs;
     std::vector<double> upper;
     std::vector<std::array<Index, 3>> common;
     std::vector<double> reach, node_lower;
     std::vector<SeparationSite> sites;  ///< per triangle: its part of separation_lower_bound()
+    std::vector<PreparedTriangleParts> prepared;  ///< per triangle: its part of triangle_distance()
     const HierarchyDiagonals* diagonals = nullptr;  ///< FrameBoxes::diagonals()
     double slack = 0;
   };
@@ -238,7 +244,7 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     s.pairs = std::make_unique<SharedPairs>(n);
     s.common = bvh.node_common_vertices(frame.objects[i].topology->faces);
     s.sites.resize(n);
-    for (size_t t = 0; t < n; ++t) s.sites[t] = separation_site(frame.objects[i].triangle(static_cast<Index>(t)));
+    s.prepared.resize(n);
     s.diagonals = &boxes.diagonals(frame, i);
     // D_u(t): the 2-ring bound, or Stage II's (which already includes it) when smaller.
     s.upper = ring2_bound[i];
@@ -249,6 +255,18 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
     s.reach = bvh.node_max(reach);
     if (voronoi) s.node_lower = bvh.node_min(voronoi->triangle_lower[i]);
     units[i] = bvh.self_pairs_below(kChunk, [&](std::int32_t a, std::int32_t b) { return enter(i, a, b); });
+  });
+  // Each triangle's parts of the separation bound and of the exact test, computed once instead
+  // of in each of its pairs (about 8 per triangle), in blocks over all objects.
+  const ObjectBlocks site_blocks(n_obj, [&](size_t i) { return ObjectBlocks::blocks_of(search[i].sites.size()); });
+  parallel_for(site_blocks.size(), threads, [&](size_t item) {
+    const auto [i, block] = site_blocks.locate(item);
+    ObjectSearch& s = search[i];
+    for (size_t t = block * kBlock; t < std::min(s.sites.size(), (block + 1) * kBlock); ++t) {
+      const Triangle tri = frame.objects[i].triangle(static_cast<Index>(t));
+      s.sites[t] = separation_site(tri);
+      s.prepared[t] = parts_of(prepare_triangle(tri));
+    }
   });
   std::vector<Task> tasks;
   for (size_t i = 0; i < n_obj; ++i)
@@ -307,13 +325,24 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
       if (!for_f && !for_g) return;
       ++c.intra_exact_tests;
       if (for_f && for_g) ++c.intra_reused;  // one evaluation serves both sides
-      const TriangleDistanceResult r = evaluate(o, f, g);
+      // evaluate(o, f, g) (f < g), its points computed only when a record takes the pair:
+      // most evaluated pairs improve neither side.
+      const Triangle tf = o.triangle(f), tg = o.triangle(g);
+      const PreparedTriangle pf = prepared_from_parts(tf, s.prepared[uf]);
+      const PreparedTriangle pg = prepared_from_parts(tg, s.prepared[ug]);
+      TriangleDistanceResult r = triangle_distance_without_points(tf, &pf, tg, &pg);
       if (r.kind == TriangleDistanceCase::Intersecting) {
         const Index io = static_cast<Index>(i);
         hits[k].push_back({io, f, io, g});
       }
-      pairs.offer(res.per_triangle[uf], uf, g, r);
-      pairs.offer(res.per_triangle[ug], ug, f, swapped(r));
+      bool have_points = r.kind == TriangleDistanceCase::Intersecting;
+      auto full = [&]() -> const TriangleDistanceResult& {
+        if (!have_points) add_closest_points(r, tf, &pf, tg, &pg);
+        have_points = true;
+        return r;
+      };
+      pairs.offer(res.per_triangle[uf], uf, g, r.distance, full);
+      pairs.offer(res.per_triangle[ug], ug, f, r.distance, [&] { return swapped(full()); });
     };
     // Pairs whose boxes overlap are considered as the descent meets them, the others after it,
     // nearer boxes first (by a counting sort into kLaterRanges equal ranges of squared box

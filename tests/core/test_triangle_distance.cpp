@@ -179,17 +179,31 @@ double reported_distance(double squared) {
   return d == 0.0 ? std::numeric_limits<double>::denorm_min() : d;
 }
 
+/// r and s are bitwise the same result.
+void expect_bitwise_equal(const TriangleDistanceResult& r, const TriangleDistanceResult& s, const char* what) {
+  EXPECT_EQ(std::memcmp(&r.distance, &s.distance, sizeof r.distance), 0)
+      << what << ": distance " << r.distance << " against " << s.distance;
+  EXPECT_EQ(std::memcmp(r.point_a.data(), s.point_a.data(), 3 * sizeof(double)), 0) << what;
+  EXPECT_EQ(std::memcmp(r.point_b.data(), s.point_b.data(), 3 * sizeof(double)), 0) << what;
+  EXPECT_EQ(r.kind, s.kind) << what;
+  EXPECT_EQ(r.feature_a, s.feature_a) << what;
+  EXPECT_EQ(r.feature_b, s.feature_b) << what;
+}
+
 /// triangle_distance's pruning skips only candidates that cannot win: r is bitwise the result
-/// of the search over all 15 candidates.
+/// of the search over all 15 candidates. So is the two-step search (distance first, points
+/// after), with the triangles prepared by the caller (from PreparedTriangleParts) or not.
 void expect_same_as_unpruned(const Triangle& a, const Triangle& b, const TriangleDistanceResult& r) {
   const TriangleDistanceResult all = detail::triangle_distance_unpruned(a, b);
-  EXPECT_EQ(std::memcmp(&r.distance, &all.distance, sizeof r.distance), 0)
-      << "distance " << r.distance << ", without pruning " << all.distance;
-  EXPECT_EQ(r.point_a, all.point_a);
-  EXPECT_EQ(r.point_b, all.point_b);
-  EXPECT_EQ(r.kind, all.kind);
-  EXPECT_EQ(r.feature_a, all.feature_a);
-  EXPECT_EQ(r.feature_b, all.feature_b);
+  expect_bitwise_equal(r, all, "pruned");
+  const PreparedTriangle pa = prepared_from_parts(a, parts_of(prepare_triangle(a)));
+  const PreparedTriangle pb = prepared_from_parts(b, parts_of(prepare_triangle(b)));
+  for (const bool prepared : {false, true}) {
+    TriangleDistanceResult two = triangle_distance_without_points(a, prepared ? &pa : nullptr, b, prepared ? &pb : nullptr);
+    EXPECT_EQ(std::memcmp(&two.distance, &all.distance, sizeof two.distance), 0) << "before the points";
+    add_closest_points(two, a, prepared ? &pa : nullptr, b, prepared ? &pb : nullptr);
+    expect_bitwise_equal(two, all, prepared ? "two steps, prepared" : "two steps");
+  }
 }
 
 /// All checks of one triangle pair against the twin; returns the result.
