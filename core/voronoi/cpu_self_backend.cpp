@@ -62,7 +62,10 @@ class CpuSelfVoronoiBackend final : public SelfVoronoiBackend {
         double band;
         double best;
       };
-      std::vector<Slot> slots;
+      // Reused from voxel to voxel: allocating it per voxel took about a sixth of the backend's
+      // instructions on cloth-funnel frame 227.
+      thread_local std::vector<Slot> slots;
+      slots.clear();
       double max_band = 0;
       for (std::size_t k = first; k < last; ++k) {
         const auto f = static_cast<std::size_t>(self.sample_triangle[k]);
