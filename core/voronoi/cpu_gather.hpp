@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdlib>
+#include <memory>
 #include <vector>
 
 namespace vproxq {
@@ -34,7 +35,9 @@ inline double cpu_prefilter_slack(const VoronoiGrid& grid) {
 /// Per triangle of a DvdInput: prepared corners and bounding box; with `entry_masks`, what
 /// for_each_in() needs to visit each triangle once.
 struct GatherTriangles {
-  std::vector<PreparedTriangle> prepared;
+  /// Default-initialised, then filled: a std::vector would zero its 200 bytes per triangle
+  /// first (value-initialisation), 5% of the inter-object Stage II on blobs-200.
+  std::unique_ptr<PreparedTriangle[]> prepared;
   std::vector<Vec3> box_lo, box_hi;
   /// With `entry_masks`, per entry of in.bin_tris: bit a set when the entry's bin is its
   /// triangle's first bin along axis a (the first bin its box overlaps), so that for_each_in()
@@ -43,7 +46,7 @@ struct GatherTriangles {
 
   GatherTriangles(const DvdInput& in, int threads, bool entry_masks = false) {
     const std::size_t n = in.tri_site.size();
-    prepared.resize(n);
+    prepared.reset(new PreparedTriangle[n]);
     box_lo.resize(n);
     box_hi.resize(n);
     parallel_for(n, threads, [&](std::size_t t) {

@@ -25,6 +25,10 @@ void put_triangle(DvdInput& in, const Frame& frame, const StageGrid& sg, size_t 
 
 double median_triangle_side(const FrameBoxes& boxes, const std::function<bool(size_t)>& include) {
   std::vector<double> sides;
+  size_t count = 0;
+  for (size_t i = 0; i < boxes.triangles.size(); ++i)
+    if (include(i)) count += boxes.triangles[i].size();
+  sides.reserve(count);
   for (size_t i = 0; i < boxes.triangles.size(); ++i) {
     if (!include(i)) continue;
     for (const AABB& b : boxes.triangles[i]) sides.push_back((b.hi - b.lo).maxCoeff());
