@@ -74,8 +74,9 @@ constexpr double kPruneMargin = 0x1p-30;
 /// The box of a segment's corners.
 inline AABB segment_box(const Vec3& p, const Vec3& q) { return {p.cwiseMin(q), p.cwiseMax(q)}; }
 
-/// The closest points of r's winning feature pair (r from search(), not intersecting), from
-/// the stand-alone primitive: its squared distance is the one the search found, bitwise.
+/// The closest points of r's winning feature pair (r from search(); an intersecting pair has
+/// its common point already), from the stand-alone primitive: its squared distance is the one
+/// the search found, bitwise.
 /// pre_a, pre_b: the prepared triangles, or null (then prepared here when needed).
 void add_points(TriangleDistanceResult& r, const Triangle& a, const PreparedTriangle* pre_a, const Triangle& b,
                 const PreparedTriangle* pre_b) {
