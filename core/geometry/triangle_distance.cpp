@@ -74,12 +74,12 @@ constexpr double kPruneMargin = 0x1p-30;
 /// The box of a segment's corners.
 inline AABB segment_box(const Vec3& p, const Vec3& q) { return {p.cwiseMin(q), p.cwiseMax(q)}; }
 
-/// The closest points of r's winning feature pair (r from search(); an intersecting pair has
-/// its common point already), from the stand-alone primitive: its squared distance is the one
-/// the search found, bitwise.
-/// pre_a, pre_b: the prepared triangles, or null (then prepared here when needed).
-void add_points(TriangleDistanceResult& r, const Triangle& a, const PreparedTriangle* pre_a, const Triangle& b,
-                const PreparedTriangle* pre_b) {
+}  // namespace
+
+// The winner's points from the stand-alone primitive (its squared distance is the one the
+// search found, bitwise); an intersecting pair has its common point already.
+void add_closest_points(TriangleDistanceResult& r, const Triangle& a, const PreparedTriangle* pre_a,
+                        const Triangle& b, const PreparedTriangle* pre_b) {
   switch (r.kind) {
     case TriangleDistanceCase::Intersecting:
       return;  // the common point is set already
@@ -105,6 +105,8 @@ void add_points(TriangleDistanceResult& r, const Triangle& a, const PreparedTria
     }
   }
 }
+
+namespace {
 
 /// The 15-candidate search, with or without pruning (see the top of the file); with kPoints,
 /// the winner's points too. pre_a, pre_b: the triangles prepared by the caller, or null.
@@ -218,7 +220,7 @@ TriangleDistanceResult search(const Triangle& a, const Triangle& b, const Prepar
     r.feature_b = static_cast<std::int8_t>((winner - kFirstEdgeEdge) % 3);
   }
   // The winner was evaluated, so the triangle its vertex case needs is prepared.
-  if constexpr (kPoints) add_points(r, a, pre_a, b, pre_b);
+  if constexpr (kPoints) add_closest_points(r, a, pre_a, b, pre_b);
   r.distance = std::sqrt(best);
   // Triangles that do not touch can still compute as 0 apart: a gap below about one ulp of
   // their coordinates (a vertex within rounding of the other's plane, say) rounds away in the
@@ -238,11 +240,6 @@ TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b) {
 TriangleDistanceResult triangle_distance_without_points(const Triangle& a, const PreparedTriangle* pa,
                                                         const Triangle& b, const PreparedTriangle* pb) {
   return search<true, false>(a, b, pa, pb);
-}
-
-void add_closest_points(TriangleDistanceResult& r, const Triangle& a, const PreparedTriangle* pa,
-                        const Triangle& b, const PreparedTriangle* pb) {
-  add_points(r, a, pa, b, pb);
 }
 
 namespace detail {

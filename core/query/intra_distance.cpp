@@ -335,7 +335,7 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
         const Index io = static_cast<Index>(i);
         hits[k].push_back({io, f, io, g});
       }
-      bool have_points = r.kind == TriangleDistanceCase::Intersecting;
+      bool have_points = false;
       auto full = [&]() -> const TriangleDistanceResult& {
         if (!have_points) add_closest_points(r, tf, &pf, tg, &pg);
         have_points = true;
