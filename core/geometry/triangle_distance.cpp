@@ -37,6 +37,17 @@
 // the search over all 15 (detail::triangle_distance_unpruned(), the twin the tests compare
 // it with). A triangle whose vertex candidates are all skipped is not prepared at all. On the
 // pairs of the intra-object distance about 4.6 of the 15 are evaluated (docs/algorithms.md, "Exactness").
+//
+// A caller's bound. triangle_distance_within() uses r = within + m instead where that is
+// smaller: by the same roundings, a candidate skipped for it computes to more than `within`.
+// So when the result computes to at most `within`, every skipped candidate computes to more
+// than the result, which is bitwise as above; otherwise the evaluated candidates compute to
+// more than `within` too (or none is left), and the answer is "farther". The roundings above
+// are relative to r, and stay below 2^-47 S while r is a few S (as sqrt(closest) + m is):
+// `within` is used only when at most 4 S (corners within S of the origin are at most
+// 2 sqrt(3) S apart, so a larger bound would skip nothing anyway). It is applied before the
+// 18 corner-to-edge distances are computed: a pair whose 15 candidates it all skips costs
+// the intersection test and the 15 bounds alone.
 #include "core/geometry/triangle_distance.hpp"
 
 #include <algorithm>
@@ -70,6 +81,8 @@ double point_triangle_squared(const detail::PointTrianglePlan& plan, const doubl
 
 /// Pruning margin per unit of the coordinates' magnitude (m above).
 constexpr double kPruneMargin = 0x1p-30;
+/// A caller's bound `within` prunes only when it is at most this many S (see the top).
+constexpr double kWithinScales = 4;
 
 /// The box of a segment's corners.
 inline AABB segment_box(const Vec3& p, const Vec3& q) { return {p.cwiseMin(q), p.cwiseMax(q)}; }
@@ -108,53 +121,95 @@ void add_closest_points(TriangleDistanceResult& r, const Triangle& a, const Prep
 
 namespace {
 
-/// The 15-candidate search, with or without pruning (see the top of the file); with kPoints,
-/// the winner's points too. pre_a, pre_b: the triangles prepared by the caller, or null.
-template <bool kPrune, bool kPoints>
-TriangleDistanceResult search(const Triangle& a, const Triangle& b, const PreparedTriangle* pre_a,
-                              const PreparedTriangle* pre_b) {
-  TriangleDistanceResult r;
-  const IntersectionResult hit = triangle_intersection(a, b);
-  if (hit.intersecting) {
-    r.distance = 0.0;
-    r.point_a = hit.point;
-    r.point_b = hit.point;
-    r.kind = TriangleDistanceCase::Intersecting;
-    return r;
+/// The squared distances of every corner of a to every edge of b (a_to_b[i][k]: corner i, edge
+/// k) and of every corner of b to every edge of a (b_to_a[j][k]), each bitwise
+/// detail::point_segment_core(corner, edge's first corner, edge's second corner).
+///
+/// With SSE2 the two are computed side by side, a_to_b[i][k] in the low lane and b_to_a[i][k]
+/// in the high one, from shared differences, by the core's operations in its order (Eigen
+/// sums a Vec3's dot product as (x0 y0 + x1 y1) + x2 y2; core/ has no FMA contraction):
+///   - ap, the corner minus the edge's first corner: a_i - b_k and b_i - a_k, i.e. P_i - Q_k
+///     with P_i = (a_i, b_i) and Q_k = (b_k, a_k);
+///   - d, the edge: Q_{k+1} - Q_k, so db_k and da_k;
+///   - the end's squared distance (the core's (edge's second corner - corner) squared): the
+///     squares of Q_{k+1} - P_i, that is of ap at (i, k+1) negated, which rounds alike;
+///   - t = max(0, min(along / dd, 1)) with the core's operand order (min_value(x, 1) is
+///     minsd(1, x); max_value(0, m) is maxsd(m, 0)), then (t d - ap) squared, and the select.
+inline void corner_to_edge(const Triangle& a, const Triangle& b, double (&a_to_b)[3][3], double (&b_to_a)[3][3]) {
+#if defined(__SSE2__)
+  __m128d p[3][3], q[3][3];  // [corner][axis]: P = (a, b), Q = (b, a)
+  for (int i = 0; i < 3; ++i) {
+    for (int x = 0; x < 3; ++x) {
+      p[i][x] = _mm_set_pd(b[i][x], a[i][x]);
+      q[i][x] = _mm_shuffle_pd(p[i][x], p[i][x], 1);
+    }
   }
-  // Search with squared distances only. Every corner against every edge of the other triangle
-  // is computed once: these 18 values serve both the vertex-triangle candidates (their edge
-  // parts) and the edge-edge candidates (their boundary parts).
-  double a_to_b[3][3];  // [corner of a][edge of b]
-  double b_to_a[3][3];  // [corner of b][edge of a]
+  auto norm2 = [](const __m128d (&v)[3]) {
+    return _mm_add_pd(_mm_add_pd(_mm_mul_pd(v[0], v[0]), _mm_mul_pd(v[1], v[1])), _mm_mul_pd(v[2], v[2]));
+  };
+  __m128d ap[3][3][3], ap2[3][3], d[3][3], dd[3];
+  for (int i = 0; i < 3; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      for (int x = 0; x < 3; ++x) ap[i][k][x] = _mm_sub_pd(p[i][x], q[k][x]);
+      ap2[i][k] = norm2(ap[i][k]);
+    }
+  }
+  for (int k = 0; k < 3; ++k) {
+    for (int x = 0; x < 3; ++x) d[k][x] = _mm_sub_pd(q[(k + 1) % 3][x], q[k][x]);
+    dd[k] = norm2(d[k]);
+  }
+  const __m128d zero = _mm_setzero_pd(), one = _mm_set1_pd(1.0);
+  for (int i = 0; i < 3; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      const __m128d(&v)[3] = ap[i][k];
+      const __m128d(&e)[3] = d[k];
+      const __m128d along =
+          _mm_add_pd(_mm_add_pd(_mm_mul_pd(v[0], e[0]), _mm_mul_pd(v[1], e[1])), _mm_mul_pd(v[2], e[2]));
+      const __m128d t = _mm_max_pd(_mm_min_pd(one, _mm_div_pd(along, dd[k])), zero);
+      const __m128d w[3] = {_mm_sub_pd(_mm_mul_pd(t, e[0]), v[0]), _mm_sub_pd(_mm_mul_pd(t, e[1]), v[1]),
+                            _mm_sub_pd(_mm_mul_pd(t, e[2]), v[2])};
+      const __m128d at_end = _mm_cmpeq_pd(t, one);
+      const __m128d sq = _mm_or_pd(_mm_and_pd(at_end, ap2[i][(k + 1) % 3]), _mm_andnot_pd(at_end, norm2(w)));
+      _mm_storel_pd(&a_to_b[i][k], sq);
+      _mm_storeh_pd(&b_to_a[i][k], sq);
+    }
+  }
+#else
   for (int i = 0; i < 3; ++i) {
     for (int k = 0; k < 3; ++k) {
       a_to_b[i][k] = detail::point_segment_core(a[i], b[k], b[(k + 1) % 3]).squared_distance;
       b_to_a[i][k] = detail::point_segment_core(b[i], a[k], a[(k + 1) % 3]).squared_distance;
     }
   }
-  double best = kInfinity;
-  int winner = -1;
-  auto offer = [&](double squared, int candidate) {
-    const bool better = squared < best;  // strictly: ties keep the earlier candidate
-    winner = better ? candidate : winner;
-    best = detail::select(better, squared, best);
-  };
-  // Pruning: a candidate whose features' boxes are more than r apart (squared: limit) is
-  // skipped; without it, limit stays infinite and nothing is.
-  double limit = kInfinity, wlimit = kInfinity;
-  AABB box_a, box_b;
-  double pa[3] = {0, 0, 0}, pb[3] = {0, 0, 0}, pa_max = 0, pb_min = 0;
+#endif
+}
+
+/// The 15-candidate search, with or without pruning (see the top of the file); with kPoints,
+/// the winner's points too. pre_a, pre_b: the triangles prepared by the caller, or null.
+/// Returns false, leaving r unspecified, exactly when the result's distance exceeds `within`
+/// (with pruning; without, pass infinity).
+template <bool kPrune, bool kPoints>
+bool search(const Triangle& a, const Triangle& b, const PreparedTriangle* pre_a, const PreparedTriangle* pre_b,
+            double within, TriangleDistanceResult& r) {
+  r = TriangleDistanceResult{};
+  const IntersectionResult hit = triangle_intersection(a, b);
+  if (hit.intersecting) {
+    r.distance = 0.0;
+    r.point_a = hit.point;
+    r.point_b = hit.point;
+    r.kind = TriangleDistanceCase::Intersecting;
+    return r.distance <= within;
+  }
+  // What the pruning reads: the triangles' boxes and their edges' boxes, the corners'
+  // projections onto w (b's centroid minus a's, times 3) and each edge's extreme one.
+  double scale = 0, wnorm = 0;
+  AABB box_a, box_b, edge_box_a[3], edge_box_b[3];
+  double pa[3] = {0, 0, 0}, pb[3] = {0, 0, 0}, pa_max = 0, pb_min = 0, edge_hi_a[3] = {0, 0, 0},
+         edge_lo_b[3] = {0, 0, 0};
   if constexpr (kPrune) {
-    double closest = kInfinity, scale = 0;
-    for (int i = 0; i < 3; ++i) {
-      for (int k = 0; k < 3; ++k) {
-        closest = detail::min_value(closest, detail::min_value(a_to_b[i][k], b_to_a[i][k]));
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k)
         scale = detail::max_value(scale, detail::max_value(std::fabs(a[i][k]), std::fabs(b[i][k])));
-      }
-    }
-    const double r = std::sqrt(closest) + kPruneMargin * scale;
-    limit = r * r;
     box_a = AABB::of(a);
     box_b = AABB::of(b);
     const Vec3 w = (b[0] + b[1] + b[2]) - (a[0] + a[1] + a[2]);
@@ -164,10 +219,68 @@ TriangleDistanceResult search(const Triangle& a, const Triangle& b, const Prepar
     }
     pa_max = std::max({pa[0], pa[1], pa[2]});
     pb_min = std::min({pb[0], pb[1], pb[2]});
-    wlimit = r * std::sqrt(w.squaredNorm());
+    wnorm = std::sqrt(w.squaredNorm());
+    for (int k = 0; k < 3; ++k) {
+      const int k1 = (k + 1) % 3;
+      edge_box_a[k] = segment_box(a[k], a[k1]);
+      edge_box_b[k] = segment_box(b[k], b[k1]);
+      edge_hi_a[k] = std::max(pa[k], pa[k1]);
+      edge_lo_b[k] = std::min(pb[k], pb[k1]);
+    }
   }
-  auto skipped = [&](const AABB& p, const AABB& q) { return kPrune && box_distance_squared(p, q) > limit; };
-  auto apart = [&](double a_hi, double b_lo) { return kPrune && b_lo - a_hi > wlimit; };
+  // Candidate c is skipped when its features are more than r apart by their boxes (squared:
+  // limit) or along w (wlimit = r |w|); without pruning, nothing is.
+  double limit = kInfinity, wlimit = kInfinity;
+  auto kept = [&](int c) {
+    if constexpr (!kPrune) {
+      return true;
+    } else {
+      double gap, box2;
+      if (c < kFirstFaceVertex) {
+        gap = pb_min - pa[c];
+        if (gap > wlimit) return false;
+        box2 = box_distance_squared({a[c], a[c]}, box_b);
+      } else if (c < kFirstEdgeEdge) {
+        const int j = c - kFirstFaceVertex;
+        gap = pb[j] - pa_max;
+        if (gap > wlimit) return false;
+        box2 = box_distance_squared({b[j], b[j]}, box_a);
+      } else {
+        const int ea = (c - kFirstEdgeEdge) / 3, eb = (c - kFirstEdgeEdge) % 3;
+        gap = edge_lo_b[eb] - edge_hi_a[ea];
+        if (gap > wlimit) return false;
+        box2 = box_distance_squared(edge_box_a[ea], edge_box_b[eb]);
+      }
+      return !(box2 > limit);
+    }
+  };
+  // A caller's bound: used when small enough for the rounding argument (see the top).
+  double r_within = kInfinity;
+  if constexpr (kPrune) {
+    if (within <= kWithinScales * scale) r_within = within + kPruneMargin * scale;
+  }
+  // Search with squared distances only. Every corner against every edge of the other triangle
+  // is computed once: these 18 values serve both the vertex-triangle candidates (their edge
+  // parts) and the edge-edge candidates (their boundary parts).
+  double a_to_b[3][3];  // [corner of a][edge of b]
+  double b_to_a[3][3];  // [corner of b][edge of a]
+  corner_to_edge(a, b, a_to_b, b_to_a);
+  double best = kInfinity;
+  int winner = -1;
+  auto offer = [&](double squared, int candidate) {
+    const bool better = squared < best;  // strictly: ties keep the earlier candidate
+    winner = better ? candidate : winner;
+    best = detail::select(better, squared, best);
+  };
+  if constexpr (kPrune) {
+    double closest = kInfinity;
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k)
+        closest = detail::min_value(closest, detail::min_value(a_to_b[i][k], b_to_a[i][k]));
+    const double r = std::min(std::sqrt(closest) + kPruneMargin * scale, r_within);
+    limit = r * r;
+    wlimit = r * wnorm;
+  }
   // Each triangle is prepared when a vertex candidate against it is evaluated first (unless
   // the caller prepared it: prepare_triangle() is deterministic, so that is the same).
   PreparedTriangle prepared_a, prepared_b;
@@ -179,34 +292,34 @@ TriangleDistanceResult search(const Triangle& a, const Triangle& b, const Prepar
     return *have;
   };
   for (int i = 0; i < 3; ++i) {
-    if (apart(pa[i], pb_min) || skipped({a[i], a[i]}, box_b)) continue;
+    if (!kept(i)) continue;
     offer(point_triangle_squared(detail::plan_point_triangle(a[i], prepared(b, prepared_b, pre_b)), a_to_b[i]), i);
   }
   for (int j = 0; j < 3; ++j) {
-    if (apart(pa_max, pb[j]) || skipped({b[j], b[j]}, box_a)) continue;
-    offer(point_triangle_squared(detail::plan_point_triangle(b[j], prepared(a, prepared_a, pre_a)), b_to_a[j]),
-          kFirstFaceVertex + j);
+    const int c = kFirstFaceVertex + j;
+    if (!kept(c)) continue;
+    offer(point_triangle_squared(detail::plan_point_triangle(b[j], prepared(a, prepared_a, pre_a)), b_to_a[j]), c);
   }
   for (int ea = 0; ea < 3; ++ea) {
     const int ea1 = (ea + 1) % 3;
     for (int eb = 0; eb < 3; ++eb) {
+      const int c = kFirstEdgeEdge + 3 * ea + eb;
+      if (!kept(c)) continue;
       const int eb1 = (eb + 1) % 3;
-      if (apart(std::max(pa[ea], pa[ea1]), std::min(pb[eb], pb[eb1])) ||
-          skipped(segment_box(a[ea], a[ea1]), segment_box(b[eb], b[eb1])))
-        continue;
-      const detail::SegmentInteriorCore interior =
-          detail::segment_interior_core(a[ea], a[ea1], b[eb], b[eb1]);
+      const detail::SegmentInteriorCore interior = detail::segment_interior_core(a[ea], a[ea1], b[eb], b[eb1]);
       // The boundary's value (which endpoint wins does not matter for the value).
       const double from_a = detail::min_value(a_to_b[ea][eb], a_to_b[ea1][eb]);
       const double from_b = detail::min_value(b_to_a[eb][ea], b_to_a[eb1][ea]);
       const double boundary = detail::min_value(from_a, from_b);
-      offer(detail::select(interior.found, interior.squared_distance, boundary),
-            kFirstEdgeEdge + 3 * ea + eb);
+      offer(detail::select(interior.found, interior.squared_distance, boundary), c);
     }
   }
-  if (winner < 0) {  // only for NaN input, which is outside the contract
+  if (winner < 0) {
+    // Every candidate skipped: by `within` (the result is farther), or for NaN input, which
+    // is outside the contract.
+    if (r_within < kInfinity) return false;
     r.distance = std::numeric_limits<double>::quiet_NaN();
-    return r;
+    return true;
   }
   if (winner < kFirstFaceVertex) {
     r.kind = TriangleDistanceCase::VertexFace;
@@ -219,8 +332,6 @@ TriangleDistanceResult search(const Triangle& a, const Triangle& b, const Prepar
     r.feature_a = static_cast<std::int8_t>((winner - kFirstEdgeEdge) / 3);
     r.feature_b = static_cast<std::int8_t>((winner - kFirstEdgeEdge) % 3);
   }
-  // The winner was evaluated, so the triangle its vertex case needs is prepared.
-  if constexpr (kPoints) add_closest_points(r, a, pre_a, b, pre_b);
   r.distance = std::sqrt(best);
   // Triangles that do not touch can still compute as 0 apart: a gap below about one ulp of
   // their coordinates (a vertex within rounding of the other's plane, say) rounds away in the
@@ -228,23 +339,37 @@ TriangleDistanceResult search(const Triangle& a, const Triangle& b, const Prepar
   // above), so such a pair gets the smallest positive double instead: as accurate as 0, and a
   // touching pair beats it in every search and tie-break.
   if (r.distance == 0.0) r.distance = std::numeric_limits<double>::denorm_min();
-  return r;
+  if (!(r.distance <= within)) return false;
+  // The winner was evaluated, so the triangle its vertex case needs is prepared.
+  if constexpr (kPoints) add_closest_points(r, a, pre_a, b, pre_b);
+  return true;
 }
 
 }  // namespace
 
 TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b) {
-  return search<true, true>(a, b, nullptr, nullptr);
+  TriangleDistanceResult r;
+  search<true, true>(a, b, nullptr, nullptr, kInfinity, r);
+  return r;
 }
 
 TriangleDistanceResult triangle_distance_without_points(const Triangle& a, const PreparedTriangle* pa,
                                                         const Triangle& b, const PreparedTriangle* pb) {
-  return search<true, false>(a, b, pa, pb);
+  TriangleDistanceResult r;
+  search<true, false>(a, b, pa, pb, kInfinity, r);
+  return r;
+}
+
+bool triangle_distance_within(const Triangle& a, const PreparedTriangle* pa, const Triangle& b,
+                              const PreparedTriangle* pb, double within, TriangleDistanceResult& r) {
+  return search<true, false>(a, b, pa, pb, within, r);
 }
 
 namespace detail {
 TriangleDistanceResult triangle_distance_unpruned(const Triangle& a, const Triangle& b) {
-  return search<false, true>(a, b, nullptr, nullptr);
+  TriangleDistanceResult r;
+  search<false, true>(a, b, nullptr, nullptr, kInfinity, r);
+  return r;
 }
 }  // namespace detail
 

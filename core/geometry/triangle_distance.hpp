@@ -53,7 +53,15 @@ TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b);
 /// is prepared once), else null. Together, bitwise the numbers of triangle_distance(a, b).
 TriangleDistanceResult triangle_distance_without_points(const Triangle& a, const PreparedTriangle* pa,
                                                         const Triangle& b, const PreparedTriangle* pb);
-/// Fills in the points of r, from triangle_distance_without_points(a, pa, b, pb).
+/// triangle_distance_without_points() for a caller that needs the result only when it is
+/// within `within` (>= 0, not NaN; infinity: always): true and r set, bitwise those numbers,
+/// when triangle_distance(a, b).distance <= within; else false, r unspecified. Feature pairs
+/// whose features are farther apart than `within` are skipped as well, so far pairs cost
+/// less (a search that keeps the nearest pair passes its best so far).
+bool triangle_distance_within(const Triangle& a, const PreparedTriangle* pa, const Triangle& b,
+                              const PreparedTriangle* pb, double within, TriangleDistanceResult& r);
+/// Fills in the points of r, from triangle_distance_without_points(a, pa, b, pb) (or a true
+/// triangle_distance_within()).
 void add_closest_points(TriangleDistanceResult& r, const Triangle& a, const PreparedTriangle* pa,
                         const Triangle& b, const PreparedTriangle* pb);
 

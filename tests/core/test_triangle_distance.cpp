@@ -203,6 +203,18 @@ void expect_same_as_unpruned(const Triangle& a, const Triangle& b, const Triangl
     EXPECT_EQ(std::memcmp(&two.distance, &all.distance, sizeof two.distance), 0) << "before the points";
     add_closest_points(two, a, prepared ? &pa : nullptr, b, prepared ? &pb : nullptr);
     expect_bitwise_equal(two, all, prepared ? "two steps, prepared" : "two steps");
+    // With a caller's bound: the same numbers exactly when the distance is within it, around
+    // the distance and far from it.
+    const double d = all.distance;
+    for (const double within : {0.0, d * 0.5, std::nextafter(d, 0.0), d, std::nextafter(d, kInfinity), d * 2,
+                                d * 1e6 + 1, kInfinity}) {
+      TriangleDistanceResult w;
+      const bool kept = triangle_distance_within(a, prepared ? &pa : nullptr, b, prepared ? &pb : nullptr, within, w);
+      EXPECT_EQ(kept, d <= within) << "within " << within << ", distance " << d;
+      if (!kept) continue;
+      add_closest_points(w, a, prepared ? &pa : nullptr, b, prepared ? &pb : nullptr);
+      expect_bitwise_equal(w, all, "within a bound");
+    }
   }
 }
 

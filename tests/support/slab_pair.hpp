@@ -349,6 +349,19 @@ inline std::string check_slab_pair(const SlabPair& s, double* worst = nullptr) {
            << static_cast<int>(all.kind) << ", features " << int{all.feature_a} << ", " << int{all.feature_b} << ")";
       return fail.str();
     }
+    // With a caller's bound at the distance and just below it: kept exactly when within it,
+    // then bitwise the same numbers.
+    for (const double within : {r.distance, std::nextafter(r.distance, 0.0)}) {
+      TriangleDistanceResult w;
+      const bool kept = triangle_distance_within(x, nullptr, y, nullptr, within, w);
+      if (kept != (r.distance <= within) ||
+          (kept && (std::memcmp(&w.distance, &r.distance, sizeof r.distance) != 0 || w.kind != r.kind ||
+                    w.feature_a != r.feature_a || w.feature_b != r.feature_b))) {
+        fail << name << ": triangle_distance_within(" << within << ") " << (kept ? "kept" : "dropped")
+             << " the pair at distance " << r.distance;
+        return fail.str();
+      }
+    }
     const bool intersecting = r.kind == TriangleDistanceCase::Intersecting;
     if (intersecting != contact || triangles_intersect(x, y) != contact) {
       fail << name << ": reported " << (intersecting ? "" : "not ") << "intersecting, triangles_intersect "
