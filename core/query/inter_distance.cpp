@@ -3,6 +3,7 @@
 #include "core/broad_phase/object_broad_phase.hpp"
 #include "core/broad_phase/triangle_bvh.hpp"
 #include "core/geometry/separation_bound.hpp"
+#include "core/geometry/triangle_distance.hpp"
 #include "core/parallel.hpp"
 #include "core/timer.hpp"
 #include "core/voronoi/stage2.hpp"
@@ -59,6 +60,27 @@ void consider(const Frame& frame, Index i, Index ts, Index j, Index to, Best& be
     best.tri_other = to;
     best.detail = r;
   }
+}
+
+/// consider() for a search whose pairs mostly lose: a pair farther than `within` (at least
+/// best.distance, or the search's bound where that is smaller: a pair beyond it is not the
+/// answer) is dropped as soon as that is certain, and the points are computed only for a pair
+/// that improves `best`. Bitwise the same numbers as consider().
+void consider_within(const Frame& frame, Index i, Index ts, Index j, Index to, double within, Best& best) {
+  const bool i_first = i < j;
+  const Triangle ti = frame.objects[static_cast<size_t>(i)].triangle(ts);
+  const Triangle tj = frame.objects[static_cast<size_t>(j)].triangle(to);
+  const Triangle& first = i_first ? ti : tj;
+  const Triangle& second = i_first ? tj : ti;
+  TriangleDistanceResult r;
+  if (!triangle_distance_within(first, nullptr, second, nullptr, within, r)) return;
+  if (!best.improved_by(r.distance, j, ts, to)) return;
+  add_closest_points(r, first, nullptr, second, nullptr);
+  best.distance = r.distance;
+  best.other = j;
+  best.tri_self = ts;
+  best.tri_other = to;
+  best.detail = i_first ? r : swapped(r);
 }
 
 InterObjectDistance to_result(Index i, const Best& best) {
@@ -122,7 +144,7 @@ void search_object(const Frame& frame, const FrameBoxes& boxes,
       ++counters.separation_culled;
       return;
     }
-    consider(frame, i, ts, j, to, best);
+    consider_within(frame, i, ts, j, to, std::min(best.distance, u + slack), best);
     ++counters.exact_tests;
   };
   scratch.search.clear();

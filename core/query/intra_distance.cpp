@@ -326,11 +326,17 @@ IntraDistanceOutput intra_object_distance(const Frame& frame, const FrameBoxes& 
       ++c.intra_exact_tests;
       if (for_f && for_g) ++c.intra_reused;  // one evaluation serves both sides
       // evaluate(o, f, g) (f < g), its points computed only when a record takes the pair:
-      // most evaluated pairs improve neither side.
+      // most evaluated pairs improve neither side. A pair farther than the bound of each side
+      // it is a candidate for is the nearest of neither (a bound never drops below the
+      // computed distance of its triangle's nearest pair; on the other side the pair lies
+      // beyond the bound already), so its exact test stops as soon as that is certain, and it
+      // is not offered.
       const Triangle tf = o.triangle(f), tg = o.triangle(g);
       const PreparedTriangle pf = prepared_from_parts(tf, s.prepared[uf]);
       const PreparedTriangle pg = prepared_from_parts(tg, s.prepared[ug]);
-      TriangleDistanceResult r = triangle_distance_without_points(tf, &pf, tg, &pg);
+      const double within = std::max(for_f ? bf : 0.0, for_g ? bg : 0.0);
+      TriangleDistanceResult r;
+      if (!triangle_distance_within(tf, &pf, tg, &pg, within, r)) return;
       if (r.kind == TriangleDistanceCase::Intersecting) {
         const Index io = static_cast<Index>(i);
         hits[k].push_back({io, f, io, g});
