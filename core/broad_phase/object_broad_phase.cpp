@@ -158,12 +158,26 @@ const Enclosure& enclosure(const Frame& frame, const FrameBoxes& boxes, size_t i
     AABB point;
     point.extend(c);
     double outer2 = 0, inner2 = kInfinity;
+    const double margin = 0x1p-40 * boxes.magnitudes[i];
     for (Index t = 0; t < o.num_triangles(); ++t) {
       const Triangle tri = o.triangle(t);
       for (const Vec3& v : tri) outer2 = std::max(outer2, (v - c).squaredNorm());
       // A triangle whose box is no nearer than the nearest triangle so far cannot lower it
       // (the box distance is exact up to one rounding, below the triangle's distance).
       if (box_distance_squared(point, boxes.triangles[i][static_cast<size_t>(t)]) > inner2) continue;
+      // Nor can one whose plane lies farther from c than the nearest so far by a margin: the
+      // plane's distance P is at most the triangle's D; computed, P is off by less than 2^-46 M
+      // (M: the object's magnitude, which bounds c and the corners; a dot product of
+      // differences, then one division and a square root) and D by less than 2^-49 M
+      // (triangle_distance.cpp), so a plane more than 2^-40 M beyond sqrt(inner2) means a
+      // computed D above it, and inner2 stays bitwise the minimum over all triangles. On a
+      // rounded shape almost every triangle faces c, and this skips it for the cost of a
+      // cross product instead of a point-triangle distance (an exactly rounded normal first).
+      // (Normals whose n . n is below 2^-900 or not finite are not used: no underflow enters.)
+      const Vec3 n = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
+      const double nn = n.squaredNorm();
+      if (nn >= 0x1p-900 && std::isfinite(nn) && std::fabs(n.dot(c - tri[0])) / std::sqrt(nn) > std::sqrt(inner2) + margin)
+        continue;
       // The computed closest point lies on the triangle up to coordinate rounding, so this is
       // at most a few ulps of the magnitude above the exact distance (rounding_slack() covers it).
       inner2 = std::min(inner2, point_triangle_distance(c, tri).squared_distance);
