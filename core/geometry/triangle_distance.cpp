@@ -45,9 +45,10 @@
 // more than `within` too (or none is left), and the answer is "farther". The roundings above
 // are relative to r, and stay below 2^-47 S while r is a few S (as sqrt(closest) + m is):
 // `within` is used only when at most 4 S (corners within S of the origin are at most
-// 2 sqrt(3) S apart, so a larger bound would skip nothing anyway). It is applied before the
-// 18 corner-to-edge distances are computed: a pair whose 15 candidates it all skips costs
-// the intersection test and the 15 bounds alone.
+// 2 sqrt(3) S apart, so a larger bound would skip nothing anyway). It joins the radius from
+// the 18 corner-to-edge distances, which are still computed: applied before them, it skipped
+// all 15 candidates of 6 in 100,000 pairs of the intra-object search (funnel), and the extra
+// pass over the 15 bounds cost more than that saved.
 #include "core/geometry/triangle_distance.hpp"
 
 #include <algorithm>
