@@ -354,13 +354,6 @@ TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b) {
   return r;
 }
 
-TriangleDistanceResult triangle_distance_without_points(const Triangle& a, const PreparedTriangle* pa,
-                                                        const Triangle& b, const PreparedTriangle* pb) {
-  TriangleDistanceResult r;
-  search<true, false>(a, b, pa, pb, kInfinity, r);
-  return r;
-}
-
 bool triangle_distance_within(const Triangle& a, const PreparedTriangle* pa, const Triangle& b,
                               const PreparedTriangle* pb, double within, TriangleDistanceResult& r) {
   return search<true, false>(a, b, pa, pb, within, r);

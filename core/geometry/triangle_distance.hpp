@@ -45,23 +45,19 @@ struct TriangleDistanceResult {
 /// holds for coordinates of magnitude in [2^-200, 2^200] or zero (predicates.hpp).
 TriangleDistanceResult triangle_distance(const Triangle& a, const Triangle& b);
 
-/// triangle_distance() in two steps, for callers that keep few of the pairs they evaluate:
-/// this gives the distance, the case and the features, with the points left at zero (but for
-/// an intersecting pair, whose common point is set); add_closest_points() then fills in the
-/// points of a result that is kept. `pa` and `pb` are prepare_triangle(a) and
-/// prepare_triangle(b) when the caller has them (each triangle of a search met in many pairs
-/// is prepared once), else null. Together, bitwise the numbers of triangle_distance(a, b).
-TriangleDistanceResult triangle_distance_without_points(const Triangle& a, const PreparedTriangle* pa,
-                                                        const Triangle& b, const PreparedTriangle* pb);
-/// triangle_distance_without_points() for a caller that needs the result only when it is
-/// within `within` (>= 0, not NaN; infinity: always): true and r set, bitwise those numbers,
-/// when triangle_distance(a, b).distance <= within; else false, r unspecified. Feature pairs
-/// whose features are farther apart than `within` are skipped as well, so far pairs cost
-/// less (a search that keeps the nearest pair passes its best so far).
+/// triangle_distance() in two steps, for callers that keep few of the pairs they evaluate,
+/// and only those within a bound `within` (>= 0, not NaN; infinity: no bound): true when
+/// triangle_distance(a, b).distance <= within, with r set to its distance, case and features,
+/// the points left at zero (but for an intersecting pair, whose common point is set); else
+/// false, r unspecified. add_closest_points() then fills in the points of a result that is
+/// kept. Feature pairs farther apart than `within` are skipped too, so far pairs cost less (a
+/// search that keeps the nearest pair passes its best so far). `pa` and `pb` are
+/// prepare_triangle(a) and prepare_triangle(b) when the caller has them (each triangle of a
+/// search met in many pairs is prepared once), else null. Together, bitwise the numbers of
+/// triangle_distance(a, b).
 bool triangle_distance_within(const Triangle& a, const PreparedTriangle* pa, const Triangle& b,
                               const PreparedTriangle* pb, double within, TriangleDistanceResult& r);
-/// Fills in the points of r, from triangle_distance_without_points(a, pa, b, pb) (or a true
-/// triangle_distance_within()).
+/// Fills in the points of r, from a true triangle_distance_within(a, pa, b, pb, ...).
 void add_closest_points(TriangleDistanceResult& r, const Triangle& a, const PreparedTriangle* pa,
                         const Triangle& b, const PreparedTriangle* pb);
 

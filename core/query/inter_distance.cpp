@@ -29,6 +29,14 @@ struct Best {
   bool improved_by(double d, Index o, Index ts, Index to) const {
     return std::tie(d, o, ts, to) < std::tie(distance, other, tri_self, tri_other);
   }
+  /// The pair (own triangle ts, triangle `to` of object o), r from this object's side.
+  void take(const TriangleDistanceResult& r, Index o, Index ts, Index to) {
+    distance = r.distance;
+    other = o;
+    tri_self = ts;
+    tri_other = to;
+    detail = r;
+  }
 
   /// Once the answer is a contact (distance 0), no pair can be strictly closer, so only a
   /// pair with smaller ids can still win the tie-break: (o, ts, to) lexicographically before
@@ -53,13 +61,7 @@ TriangleDistanceResult evaluate(const Frame& frame, Index i, Index ts, Index j, 
 
 void consider(const Frame& frame, Index i, Index ts, Index j, Index to, Best& best) {
   const TriangleDistanceResult r = evaluate(frame, i, ts, j, to);
-  if (best.improved_by(r.distance, j, ts, to)) {
-    best.distance = r.distance;
-    best.other = j;
-    best.tri_self = ts;
-    best.tri_other = to;
-    best.detail = r;
-  }
+  if (best.improved_by(r.distance, j, ts, to)) best.take(r, j, ts, to);
 }
 
 /// consider() for a search whose pairs mostly lose: a pair farther than `within` (at least
@@ -76,11 +78,7 @@ void consider_within(const Frame& frame, Index i, Index ts, Index j, Index to, d
   if (!triangle_distance_within(first, nullptr, second, nullptr, within, r)) return;
   if (!best.improved_by(r.distance, j, ts, to)) return;
   add_closest_points(r, first, nullptr, second, nullptr);
-  best.distance = r.distance;
-  best.other = j;
-  best.tri_self = ts;
-  best.tri_other = to;
-  best.detail = i_first ? r : swapped(r);
+  best.take(i_first ? r : swapped(r), j, ts, to);
 }
 
 InterObjectDistance to_result(Index i, const Best& best) {

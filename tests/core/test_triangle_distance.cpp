@@ -192,19 +192,16 @@ void expect_bitwise_equal(const TriangleDistanceResult& r, const TriangleDistanc
 
 /// triangle_distance's pruning skips only candidates that cannot win: r is bitwise the result
 /// of the search over all 15 candidates. So is the two-step search (distance first, points
-/// after), with the triangles prepared by the caller (from PreparedTriangleParts) or not.
+/// after), with the triangles prepared by the caller (from PreparedTriangleParts) or not, and
+/// with a caller's bound or none.
 void expect_same_as_unpruned(const Triangle& a, const Triangle& b, const TriangleDistanceResult& r) {
   const TriangleDistanceResult all = detail::triangle_distance_unpruned(a, b);
   expect_bitwise_equal(r, all, "pruned");
   const PreparedTriangle pa = prepared_from_parts(a, parts_of(prepare_triangle(a)));
   const PreparedTriangle pb = prepared_from_parts(b, parts_of(prepare_triangle(b)));
   for (const bool prepared : {false, true}) {
-    TriangleDistanceResult two = triangle_distance_without_points(a, prepared ? &pa : nullptr, b, prepared ? &pb : nullptr);
-    EXPECT_EQ(std::memcmp(&two.distance, &all.distance, sizeof two.distance), 0) << "before the points";
-    add_closest_points(two, a, prepared ? &pa : nullptr, b, prepared ? &pb : nullptr);
-    expect_bitwise_equal(two, all, prepared ? "two steps, prepared" : "two steps");
-    // With a caller's bound: the same numbers exactly when the distance is within it, around
-    // the distance and far from it.
+    // With a caller's bound (infinity: none): the same numbers exactly when the distance is
+    // within it, around the distance and far from it; the distance before the points too.
     const double d = all.distance;
     for (const double within : {0.0, d * 0.5, std::nextafter(d, 0.0), d, std::nextafter(d, kInfinity), d * 2,
                                 d * 1e6 + 1, kInfinity}) {
@@ -212,8 +209,9 @@ void expect_same_as_unpruned(const Triangle& a, const Triangle& b, const Triangl
       const bool kept = triangle_distance_within(a, prepared ? &pa : nullptr, b, prepared ? &pb : nullptr, within, w);
       EXPECT_EQ(kept, d <= within) << "within " << within << ", distance " << d;
       if (!kept) continue;
+      EXPECT_EQ(std::memcmp(&w.distance, &all.distance, sizeof w.distance), 0) << "before the points";
       add_closest_points(w, a, prepared ? &pa : nullptr, b, prepared ? &pb : nullptr);
-      expect_bitwise_equal(w, all, "within a bound");
+      expect_bitwise_equal(w, all, prepared ? "two steps, prepared" : "two steps");
     }
   }
 }
